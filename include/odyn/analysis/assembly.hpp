@@ -1,0 +1,215 @@
+#pragma once
+// Assembly: from the user's approximate initial pose and velocities to a consistent state.
+//  1. positions: Newton on Phi(q, t) = 0 with minimum-norm steps dq = -Phi_q^+ Phi;
+//  2. velocities: Phi_q v = -Phi_t, keeping each velocity component the user gave as long as
+//     it is independent of the constraints and of the components kept before it; the rest
+//     changes as little as possible in the kinetic-energy metric;
+//  3. accelerations and multipliers from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma].
+// Redundant constraint equations are reported by name (they make lambda non-unique).
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/core/errors.hpp"
+
+namespace odyn {
+
+struct AssemblySettings {
+  double tolerance = 1e-12;  // |Phi| in every entry
+  int max_iterations = 50;
+};
+
+struct AssemblyReport {
+  int iterations = 0;
+  double position_residual = 0.0;                 // max |Phi|
+  double velocity_residual = 0.0;                 // max |Phi_q v + Phi_t|
+  std::vector<int> kept_velocity_components;      // indices into v the assembly kept
+  std::vector<int> adjusted_velocity_components;  // given components it had to change
+};
+
+namespace detail {
+template <class Model>
+Eigen::MatrixXd dense_jacobian(const Model& model, const Workspace<Model>& ws) {
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(model.num_equations(), model.num_velocities());
+  write_jacobian(model, ws, jacobian, 0, 0, false);
+  return jacobian;
+}
+
+template <class Model>
+Eigen::MatrixXd dense_mass(const Model& model) {
+  constexpr int nv = Model::nv;
+  Eigen::MatrixXd mass = Eigen::MatrixXd::Zero(model.num_velocities(), model.num_velocities());
+  for (int b = 1; b <= model.num_bodies(); ++b)
+    mass.block<nv, nv>((b - 1) * nv, (b - 1) * nv) = model.body(BodyId{b}).mass_block();
+  return mass;
+}
+
+/// Names of the constraint equations that depend on earlier ones (rank-revealing QR of Phi_q^T).
+template <class Model>
+std::vector<std::string> redundant_equations(const Model& model, const Eigen::MatrixXd& jacobian) {
+  std::vector<std::string> names;
+  if (jacobian.rows() == 0) return names;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(jacobian.transpose());
+  qr.setThreshold(1e-10);
+  const Eigen::Index rank = qr.rank();
+  for (Eigen::Index k = rank; k < jacobian.rows(); ++k) {
+    const int row = qr.colsPermutation().indices()[k];
+    names.push_back(model.constraint_name(row) + " (equation " + std::to_string(row) + ")");
+  }
+  return names;
+}
+
+/// Minimum-norm solution of the saddle-point system [A C^T; C 0] [x; y] = [f; g].
+inline void solve_saddle_point(const Eigen::MatrixXd& a, const Eigen::MatrixXd& c,
+                               const Eigen::VectorXd& f, const Eigen::VectorXd& g,
+                               Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const Eigen::Index n = a.rows(), m = c.rows();
+  Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + m, n + m);
+  kkt.topLeftCorner(n, n) = a;
+  kkt.bottomLeftCorner(m, n) = c;
+  kkt.topRightCorner(n, m) = c.transpose();
+  Eigen::VectorXd rhs(n + m);
+  rhs << f, g;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(kkt);
+  cod.setThreshold(1e-12);
+  const Eigen::VectorXd solution = cod.solve(rhs);
+  x = solution.head(n);
+  y = solution.tail(m);
+}
+}  // namespace detail
+
+/// Positions only: Newton with minimum-norm steps. Throws AssemblyError naming the joint with
+/// the largest residual if it cannot converge.
+template <class Model>
+int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblySettings& s = {}) {
+  using Space = typename Model::Space;
+  constexpr int nq = Model::nq, nv = Model::nv;
+  const int m = model.num_equations();
+  if (!ws.q.allFinite() || !ws.v.allFinite())
+    throw AssemblyError("initial state", "the initial state contains NaN or infinity");
+  auto residual_norm = [&] {
+    update_frames(model, ws);
+    evaluate_constraints(model, ws);
+    return m > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
+  };
+  double norm = residual_norm();
+  int iteration = 0;
+  for (; iteration < s.max_iterations && norm > s.tolerance && std::isfinite(norm); ++iteration) {
+    const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(jacobian);
+    const Eigen::VectorXd step = -cod.solve(ws.phi);
+    const Eigen::VectorXd start = ws.q;
+    // Halve the step until the residual decreases: a damped Newton method.
+    double fraction = 1.0;
+    double trial = norm;
+    for (int halving = 0; halving < 30; ++halving, fraction *= 0.5) {
+      for (int b = 0; b < model.num_bodies(); ++b)
+        Space::integrate(start.template segment<nq>(b * nq),
+                         fraction * step.template segment<nv>(b * nv),
+                         ws.q.template segment<nq>(b * nq));
+      trial = residual_norm();
+      if (trial < norm || !std::isfinite(norm)) break;
+    }
+    norm = trial;
+  }
+  if (!(norm <= s.tolerance)) {
+    Eigen::Index row = 0;
+    const double worst = m > 0 ? ws.phi.cwiseAbs().maxCoeff(&row) : 0.0;
+    const std::string joint = m > 0 ? model.constraint_name(static_cast<int>(row)) : "";
+    throw AssemblyError(joint, "constraints could not be satisfied after " +
+                                   std::to_string(iteration) +
+                                   " Newton iterations; largest residual " + to_text(worst) +
+                                   " at joint '" + joint +
+                                   "'. Check its points and axes, or start from a pose closer "
+                                   "to an assembled one.");
+  }
+  return iteration;
+}
+
+/// Assembles positions, velocities, accelerations and multipliers at time ws.t.
+template <class Model>
+AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const AssemblySettings& s = {}) {
+  constexpr int nv = Model::nv;
+  AssemblyReport report;
+  const Eigen::VectorXd user_velocity = ws.v;
+  report.iterations = assemble_positions(model, ws, s);
+  report.position_residual = model.num_equations() > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
+
+  const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
+  const Eigen::MatrixXd mass = detail::dense_mass(model);
+  const int m = model.num_equations(), n = model.num_velocities();
+
+  // Keep given velocity components one by one while they stay independent of the rest.
+  Eigen::MatrixXd rows = jacobian;
+  Eigen::VectorXd rhs = -ws.phi_t;
+  auto rank_of = [](const Eigen::MatrixXd& a) {
+    if (a.rows() == 0) return Eigen::Index{0};
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a.transpose());
+    qr.setThreshold(1e-10);
+    return qr.rank();
+  };
+  Eigen::Index rank = rank_of(rows);
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const auto given = model.body(BodyId{b}).given_components();
+    for (int k = 0; k < nv; ++k) {
+      if (!given[k]) continue;
+      const int index = (b - 1) * nv + k;
+      Eigen::MatrixXd extended(rows.rows() + 1, n);
+      extended << rows, Eigen::RowVectorXd::Unit(n, index);
+      const Eigen::Index extended_rank = rank_of(extended);
+      if (extended_rank > rank) {
+        rows = std::move(extended);
+        rhs.conservativeResize(rhs.size() + 1);
+        rhs[rhs.size() - 1] = user_velocity[index];
+        rank = extended_rank;
+        report.kept_velocity_components.push_back(index);
+      } else {
+        report.adjusted_velocity_components.push_back(index);
+      }
+    }
+  }
+  // min (v - v_user)^T M (v - v_user)  subject to  rows v = rhs.
+  Eigen::VectorXd correction, multipliers;
+  detail::solve_saddle_point(mass, rows, Eigen::VectorXd::Zero(n), rhs - rows * user_velocity,
+                             correction, multipliers);
+  ws.v = user_velocity + correction;
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  report.velocity_residual = m > 0 ? (jacobian * ws.v + ws.phi_t).cwiseAbs().maxCoeff() : 0.0;
+
+  // Accelerations and multipliers.
+  initialize_states(model, ws);
+  evaluate_forces(model, ws);
+  evaluate_gamma(model, ws);
+  Eigen::VectorXd vdot, lambda;
+  detail::solve_saddle_point(mass, jacobian, ws.force, ws.gamma, vdot, lambda);
+  ws.vdot = vdot;
+  ws.lambda = lambda;
+  (void)n;
+  return report;
+}
+
+/// Throws ModelError listing redundant constraint equations at the current pose, if any.
+template <class Model>
+void require_independent_constraints(const Model& model, Workspace<Model>& ws) {
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  const auto redundant = detail::redundant_equations(model, detail::dense_jacobian(model, ws));
+  if (redundant.empty()) return;
+  std::string list;
+  for (const auto& name : redundant) list += (list.empty() ? "" : ", ") + name;
+  throw ModelError(redundant.front(),
+                   "constraint equations are redundant (they repeat what other joints already "
+                   "impose): " +
+                       list +
+                       ". Replace a joint by one with fewer equations (for example a spherical "
+                       "joint instead of a revolute one) so that the mechanism is not "
+                       "over-constrained.");
+}
+
+}  // namespace odyn

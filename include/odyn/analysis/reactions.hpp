@@ -1,0 +1,49 @@
+#pragma once
+// Joint reactions from the Lagrange multipliers: the constraint's generalized force on body k
+// is -Phi_q,k^T lambda. It is reported as a force and a torque at the joint point on that
+// body, in global axes or in the joint frame on that body.
+
+#include <Eigen/Core>
+
+#include "odyn/analysis/system.hpp"
+
+namespace odyn {
+
+enum class ReactionAxes { global, joint };
+
+/// Side of a joint: the reaction on body a (exerted by b) or on body b (exerted by a).
+enum class Side { a = 0, b = 1 };
+
+template <class E>
+concept HasJointFrames = requires(const E& e) {
+  e.frame(0).point;
+};
+
+/// Reaction wrench of constraint `handle` on the body at `side`, from the workspace's last
+/// evaluated blocks and its multipliers.
+template <class Model, Constraint E>
+typename Model::Space::Wrench reaction(const Model& model, const Workspace<Model>& ws,
+                                       Handle<E> handle, Side side = Side::b,
+                                       ReactionAxes axes = ReactionAxes::global) {
+  using Space = typename Model::Space;
+  const int k = static_cast<int>(side);
+  const E& element = model.element(handle);
+  const auto& blocks = std::get<Model::template type_index<E>>(ws.blocks)[handle.index];
+  const auto lambda = ws.lambda.template segment<E::num_equations>(model.row(handle));
+  const typename Space::Velocity generalized = -blocks.jacobian[k].transpose() * lambda;
+  const auto& frame = ws.frames[element.bodies()[k].index];
+  typename Space::Vector point = Space::Vector::Zero();
+  if constexpr (HasJointFrames<E>) point = element.frame(k).point;
+  const auto wrench = Space::wrench_at(frame, point, generalized);
+  if (axes == ReactionAxes::global) return wrench;
+  typename Space::RotationMatrix joint_axes = frame.rotation;
+  if constexpr (HasJointFrames<E>) {
+    const auto& triad = element.frame(k);
+    joint_axes.col(0) = frame.direction(triad.u);
+    joint_axes.col(1) = frame.direction(triad.v);
+    joint_axes.col(2) = frame.direction(triad.w);
+  }
+  return Space::in_axes(wrench, joint_axes);
+}
+
+}  // namespace odyn

@@ -1,0 +1,256 @@
+#pragma once
+// The stages that turn a model and a state into the blocks of the equations of motion
+//   M v' + Phi_q^T lambda = Q,   Phi(q, t) = 0,   Phi_q v' = gamma.
+// Each stage reads the workspace's state and writes the workspace's buffers; elements compute
+// their own blocks and the stages scatter them, so no stage knows any element type.
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "odyn/core/element.hpp"
+#include "odyn/core/model.hpp"
+#include "odyn/core/workspace.hpp"
+
+namespace odyn {
+
+namespace detail {
+/// The input an element reads: its bodies' frames from the workspace, and the time.
+template <class E, class Frame>
+InputOf<E> input_of(const E& element, const std::vector<Frame>& frames, double t) {
+  InputOf<E> in;
+  for (int i = 0; i < E::num_bodies; ++i) in.frames[i] = &frames[element.bodies()[i].index];
+  in.t = t;
+  return in;
+}
+}  // namespace detail
+
+/// Kinematics: each body's frame from q and v.
+template <class Model>
+void update_frames(const Model& model, Workspace<Model>& ws) {
+  using Space = typename Model::Space;
+  for (int b = 1; b <= model.num_bodies(); ++b)
+    Space::make_frame(ws.q.template segment<Space::nq>((b - 1) * Space::nq),
+                      ws.v.template segment<Space::nv>((b - 1) * Space::nv), ws.frames[b]);
+}
+
+/// Constraints: every element's Phi, Jacobian blocks and Phi_t at (frames, t).
+template <class Model>
+void evaluate_constraints(const Model& model, Workspace<Model>& ws) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (Constraint<E>) {
+      auto& blocks = std::get<type>(ws.blocks);
+      const auto& rows = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        pool[i].evaluate(detail::input_of(pool[i], ws.frames, ws.t), blocks[i]);
+        ws.phi.template segment<E::num_equations>(rows[i]) = blocks[i].phi;
+        ws.phi_t.template segment<E::num_equations>(rows[i]) = blocks[i].phi_t;
+      }
+    }
+  });
+}
+
+/// Acceleration right-hand side gamma at (frames, t).
+template <class Model>
+void evaluate_gamma(const Model& model, Workspace<Model>& ws) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (Constraint<E>) {
+      const auto& rows = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        ws.gamma.template segment<E::num_equations>(rows[i]) =
+            pool[i].gamma(detail::input_of(pool[i], ws.frames, ws.t));
+    }
+  });
+}
+
+/// Applied forces: Q from every force element, field forces and the bodies' gyroscopic terms.
+template <class Model>
+void evaluate_forces(const Model& model, Workspace<Model>& ws) {
+  using Space = typename Model::Space;
+  constexpr int nv = Space::nv;
+  for (int b = 1; b <= model.num_bodies(); ++b)
+    ws.force.template segment<nv>((b - 1) * nv) =
+        Space::gyroscopic_force(model.body(BodyId{b}).inertia, ws.frames[b]);
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (FieldForce<E>) {
+      for (const E& field : pool)
+        for (int b = 1; b <= model.num_bodies(); ++b)
+          ws.force.template segment<nv>((b - 1) * nv) +=
+              field.force_on(model.body(BodyId{b}).mass, ws.frames[b]);
+    } else if constexpr (ForceElement<E>) {
+      auto& blocks = std::get<type>(ws.blocks);
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        const auto in = detail::input_of(pool[i], ws.frames, ws.t);
+        if constexpr (StatefulForce<E>)
+          pool[i].evaluate(in, std::get<type>(ws.states)[i], blocks[i]);
+        else
+          pool[i].evaluate(in, blocks[i]);
+        for (int k = 0; k < E::num_bodies; ++k) {
+          const BodyId body = pool[i].bodies()[k];
+          if (!body.is_ground())
+            ws.force.template segment<nv>(Model::velocity_offset(body)) += blocks[i].force[k];
+        }
+      }
+    }
+  });
+}
+
+/// out += Phi_q^T y, from the element blocks of the last evaluate_constraints.
+template <class Model>
+void add_jacobian_transpose_times(const Model& model, const Workspace<Model>& ws,
+                                  const Eigen::Ref<const Eigen::VectorXd>& y,
+                                  Eigen::Ref<Eigen::VectorXd> out) {
+  constexpr int nv = Model::nv;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (Constraint<E>) {
+      const auto& blocks = std::get<type>(ws.blocks);
+      const auto& rows = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        for (int k = 0; k < E::num_bodies; ++k) {
+          const BodyId body = pool[i].bodies()[k];
+          if (!body.is_ground())
+            out.template segment<nv>(Model::velocity_offset(body)).noalias() +=
+                blocks[i].jacobian[k].transpose() * y.template segment<E::num_equations>(rows[i]);
+        }
+    }
+  });
+}
+
+/// out = Phi_q x.
+template <class Model>
+void jacobian_times(const Model& model, const Workspace<Model>& ws,
+                    const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> out) {
+  constexpr int nv = Model::nv;
+  out.setZero();
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (Constraint<E>) {
+      const auto& blocks = std::get<type>(ws.blocks);
+      const auto& rows = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        for (int k = 0; k < E::num_bodies; ++k) {
+          const BodyId body = pool[i].bodies()[k];
+          if (!body.is_ground())
+            out.template segment<E::num_equations>(rows[i]).noalias() +=
+                blocks[i].jacobian[k] * x.template segment<nv>(Model::velocity_offset(body));
+        }
+    }
+  });
+}
+
+/// Writes Phi_q into `jacobian` at (row_offset, col_offset); `transposed` also writes Phi_q^T at
+/// (col_offset, row_offset) — the two off-diagonal blocks of a saddle-point matrix.
+template <class Model, class Matrix>
+void write_jacobian(const Model& model, const Workspace<Model>& ws, Matrix& target, int row_offset,
+                    int col_offset, bool with_transpose) {
+  constexpr int nv = Model::nv;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (Constraint<E>) {
+      const auto& blocks = std::get<type>(ws.blocks);
+      const auto& rows = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        for (int k = 0; k < E::num_bodies; ++k) {
+          const BodyId body = pool[i].bodies()[k];
+          if (body.is_ground()) continue;
+          const int r = row_offset + rows[i], c = col_offset + Model::velocity_offset(body);
+          target.template block<E::num_equations, nv>(r, c) = blocks[i].jacobian[k];
+          if (with_transpose)
+            target.template block<nv, E::num_equations>(c, r) = blocks[i].jacobian[k].transpose();
+        }
+    }
+  });
+}
+
+/// target(0:n, 0:n) += mass_factor M + stiffness_factor K + damping_factor C, where K = -dQ/dq
+/// and C = -dQ/dv come from the force elements that provide them and the gyroscopic terms.
+template <class Model, class Matrix>
+void add_iteration_blocks(const Model& model, const Workspace<Model>& ws, Matrix& target,
+                          double mass_factor, double stiffness_factor, double damping_factor) {
+  using Space = typename Model::Space;
+  constexpr int nv = Space::nv;
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const auto& body = model.body(BodyId{b});
+    target.template block<nv, nv>((b - 1) * nv, (b - 1) * nv) +=
+        mass_factor * body.mass_block() +
+        damping_factor * Space::gyroscopic_damping(body.inertia, ws.frames[b]);
+  }
+  if (stiffness_factor == 0.0 && damping_factor == 0.0) return;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (HasForceJacobians<E>) {
+      ForceBlocksOf<E> blocks;
+      for (const E& element : pool) {
+        element.jacobians(detail::input_of(element, ws.frames, ws.t), blocks);
+        for (int i = 0; i < E::num_bodies; ++i)
+          for (int j = 0; j < E::num_bodies; ++j) {
+            const BodyId bi = element.bodies()[i], bj = element.bodies()[j];
+            if (bi.is_ground() || bj.is_ground()) continue;
+            target.template block<nv, nv>(Model::velocity_offset(bi), Model::velocity_offset(bj)) +=
+                stiffness_factor * blocks.stiffness.template block<nv, nv>(i * nv, j * nv) +
+                damping_factor * blocks.damping.template block<nv, nv>(i * nv, j * nv);
+          }
+      }
+    }
+  });
+}
+
+/// out = M x (block diagonal, constant in body coordinates).
+template <class Model>
+void mass_times(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& x,
+                Eigen::Ref<Eigen::VectorXd> out) {
+  constexpr int nv = Model::nv;
+  for (int b = 1; b <= model.num_bodies(); ++b)
+    out.template segment<nv>((b - 1) * nv).noalias() =
+        model.body(BodyId{b}).mass_block() * x.template segment<nv>((b - 1) * nv);
+}
+
+/// Stateful force elements take their step: called once per accepted step.
+template <class Model>
+void advance_states(const Model& model, Workspace<Model>& ws) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (StatefulForce<E>) {
+      auto& states = std::get<type>(ws.states);
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        pool[i].advance(detail::input_of(pool[i], ws.frames, ws.t), states[i]);
+    }
+  });
+}
+
+/// Stateful force elements start from the current frames.
+template <class Model>
+void initialize_states(const Model& model, Workspace<Model>& ws) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (StatefulForce<E>) {
+      auto& states = std::get<type>(ws.states);
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        states[i] = pool[i].initial_state(detail::input_of(pool[i], ws.frames, ws.t));
+    }
+  });
+}
+
+template <class Model>
+double kinetic_energy(const Model& model, const Workspace<Model>& ws) {
+  constexpr int nv = Model::nv;
+  double energy = 0.0;
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const auto v = ws.v.template segment<nv>((b - 1) * nv);
+    energy += 0.5 * v.dot(model.body(BodyId{b}).mass_block() * v);
+  }
+  return energy;
+}
+
+/// Potential energy of the gravity fields and of the force elements that have one.
+template <class Model>
+double potential_energy(const Model& model, const Workspace<Model>& ws) {
+  double energy = 0.0;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (FieldForce<E>) {
+      for (const E& field : pool)
+        for (int b = 1; b <= model.num_bodies(); ++b)
+          energy += field.potential_energy(model.body(BodyId{b}).mass, ws.frames[b]);
+    } else if constexpr (HasPotential<E>) {
+      for (const E& element : pool)
+        energy += element.potential_energy(detail::input_of(element, ws.frames, ws.t));
+    }
+  });
+  return energy;
+}
+
+}  // namespace odyn

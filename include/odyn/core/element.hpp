@@ -1,0 +1,136 @@
+#pragma once
+// What an element reads and writes, and the concepts that say what an element type must provide.
+//
+// A constraint element with m equations between NB bodies fills, from its bodies' frames:
+//   phi      (m)        Phi(q, t)
+//   jacobian (m x nv)   one block per body: d(Phi-dot)/d(body velocity), i.e. Phi_q
+//   phi_t    (m)        dPhi/dt
+// and on request gamma (m), the acceleration right-hand side: Phi_q v' = gamma.
+// A force element fills its bodies' generalized forces Q and, if it has them, the blocks
+// -dQ/dq and -dQ/dv that make the Newton matrix of implicit integrators exact.
+
+#include <Eigen/Core>
+#include <array>
+#include <concepts>
+#include <string>
+#include <utility>
+
+#include "odyn/core/ids.hpp"
+
+namespace odyn {
+
+/// The frames of an element's bodies (in the order of its `bodies()`) and the time.
+template <class Space, int NB>
+struct ElementInput {
+  std::array<const typename Space::Frame*, NB> frames;
+  double t = 0.0;
+  const typename Space::Frame& body(int i) const { return *frames[i]; }
+};
+
+template <class Space, int M, int NB>
+struct ConstraintBlocks {
+  Eigen::Matrix<double, M, 1> phi;                               // (m)
+  Eigen::Matrix<double, M, 1> phi_t;                             // (m)
+  std::array<Eigen::Matrix<double, M, Space::nv>, NB> jacobian;  // NB x (m x nv)
+};
+
+template <class Space, int NB>
+struct ForceBlocks {
+  static constexpr int size = NB * Space::nv;
+  std::array<typename Space::Velocity, NB> force;  // generalized force on each body
+  Eigen::Matrix<double, size, size> stiffness;     // -dQ/dq over the element's bodies
+  Eigen::Matrix<double, size, size> damping;       // -dQ/dv over the element's bodies
+};
+
+template <class E>
+using InputOf = ElementInput<typename E::Space, E::num_bodies>;
+
+template <class E>
+concept NamedElement = requires(const E& e) {
+  typename E::Space;
+  { E::num_bodies } -> std::convertible_to<int>;
+  { e.name() } -> std::convertible_to<std::string>;
+  { e.bodies() } -> std::same_as<const std::array<BodyId, E::num_bodies>&>;
+};
+
+/// A kinematic constraint: joints and drivers.
+template <class E>
+concept Constraint = NamedElement<E> &&
+    requires(const E& e, const InputOf<E>& in,
+             ConstraintBlocks<typename E::Space, E::num_equations, E::num_bodies>& out) {
+  { E::num_equations } -> std::convertible_to<int>;
+  e.evaluate(in, out);
+  { e.gamma(in) } -> std::convertible_to<Eigen::Matrix<double, E::num_equations, 1>>;
+};
+
+template <class E>
+using BlocksOf = ConstraintBlocks<typename E::Space, E::num_equations, E::num_bodies>;
+
+template <class E>
+using ForceBlocksOf = ForceBlocks<typename E::Space, E::num_bodies>;
+
+/// A force element that needs no memory of the past.
+template <class E>
+concept StatelessForce = NamedElement<E> &&
+    requires(const E& e, const InputOf<E>& in, ForceBlocksOf<E>& out) {
+  e.evaluate(in, out);
+};
+
+/// A force element with a discrete state (for example a revolution counter). The state lives
+/// in the workspace, is read during a step and advanced once the step is accepted.
+template <class E>
+concept StatefulForce = NamedElement<E> &&
+    requires(const E& e, const InputOf<E>& in, typename E::State& state, ForceBlocksOf<E>& out) {
+  { e.initial_state(in) } -> std::same_as<typename E::State>;
+  e.evaluate(in, std::as_const(state), out);
+  e.advance(in, state);
+};
+
+template <class E>
+concept ForceElement = StatelessForce<E> || StatefulForce<E>;
+
+/// A force that acts on every body alike, such as gravity.
+template <class E>
+concept FieldForce = requires(const E& e, double mass, const typename E::Space::Frame& frame) {
+  typename E::Space;
+  { e.name() } -> std::convertible_to<std::string>;
+  { e.force_on(mass, frame) } -> std::same_as<typename E::Space::Velocity>;
+  { e.potential_energy(mass, frame) } -> std::convertible_to<double>;
+};
+
+template <class E>
+concept Element = Constraint<E> || ForceElement<E> || FieldForce<E>;
+
+/// Optional: a force element that fills `stiffness` and `damping` in `jacobians(in, out)`.
+template <class E>
+concept HasForceJacobians = requires(const E& e, const InputOf<E>& in, ForceBlocksOf<E>& out) {
+  e.jacobians(in, out);
+};
+
+/// Optional: a force element with a potential energy.
+template <class E>
+concept HasPotential = requires(const E& e, const InputOf<E>& in) {
+  { e.potential_energy(in) } -> std::convertible_to<double>;
+};
+
+/// Optional: an element that completes its own description from the bodies' initial frames
+/// (for example a reference direction the user left out). Called once, when it is added.
+template <class E>
+concept BindsToInitialPose = requires(E& e, const InputOf<E>& in) {
+  e.bind(in);
+};
+
+/// The discrete state of a force element type, or an empty placeholder.
+template <class E>
+struct StateOfImpl {
+  struct None {};
+  using type = None;
+};
+template <StatefulForce E>
+struct StateOfImpl<E> {
+  using type = typename E::State;
+};
+template <class E>
+using StateOf = typename StateOfImpl<E>::type;
+
+}  // namespace odyn

@@ -1,0 +1,100 @@
+#pragma once
+// A force at a body point, or a torque on a body: constant, or a function of time and of the
+// body's frame (its pose and velocity). Given in the global frame or in body axes.
+
+#include <functional>
+#include <string>
+
+#include "odyn/core/element.hpp"
+#include "odyn/core/errors.hpp"
+
+namespace odyn {
+
+enum class Axes { global, body };
+
+template <class SpaceT>
+class PointForceT {
+ public:
+  using Space = SpaceT;
+  using Vector = typename Space::Vector;
+  using Frame = typename Space::Frame;
+  using Function = std::function<Vector(double t, const Frame& body)>;
+  static constexpr int num_bodies = 1;
+
+  PointForceT(std::string name, BodyId body, const Vector& point, Function force,
+              Axes axes = Axes::global)
+      : name_(std::move(name)),
+        bodies_{body},
+        point_(point),
+        force_(std::move(force)),
+        axes_(axes) {
+    if (!force_) throw ModelError(name_, "the force function is empty");
+    if (!point_.allFinite()) throw ModelError(name_, "point is not finite");
+  }
+  PointForceT(std::string name, BodyId body, const Vector& point, const Vector& force,
+              Axes axes = Axes::global)
+      : PointForceT(std::move(name), body, point, constant(force), axes) {
+    if (!force.allFinite()) throw ModelError(name_, "force is not finite");
+  }
+
+  const std::string& name() const { return name_; }
+  const std::array<BodyId, 1>& bodies() const { return bodies_; }
+
+  void evaluate(const ElementInput<Space, 1>& in, ForceBlocks<Space, 1>& out) const {
+    const Frame& body = in.body(0);
+    Vector f = force_(in.t, body);
+    if (axes_ == Axes::body) f = body.direction(f);
+    out.force[0] = body.point_jacobian(point_).transpose() * f;
+  }
+
+ private:
+  static Function constant(const Vector& f) {
+    return [f](double, const Frame&) { return f; };
+  }
+  std::string name_;
+  std::array<BodyId, 1> bodies_;
+  Vector point_;
+  Function force_;
+  Axes axes_;
+};
+
+template <class SpaceT>
+class PointTorqueT {
+ public:
+  using Space = SpaceT;
+  using Angular = typename Space::Angular;
+  using Frame = typename Space::Frame;
+  using Function = std::function<Angular(double t, const Frame& body)>;
+  static constexpr int num_bodies = 1;
+
+  PointTorqueT(std::string name, BodyId body, Function torque, Axes axes = Axes::global)
+      : name_(std::move(name)), bodies_{body}, torque_(std::move(torque)), axes_(axes) {
+    if (!torque_) throw ModelError(name_, "the torque function is empty");
+  }
+  PointTorqueT(std::string name, BodyId body, const Angular& torque, Axes axes = Axes::global)
+      : PointTorqueT(std::move(name), body, constant(torque), axes) {
+    if (!torque.allFinite()) throw ModelError(name_, "torque is not finite");
+  }
+
+  const std::string& name() const { return name_; }
+  const std::array<BodyId, 1>& bodies() const { return bodies_; }
+
+  void evaluate(const ElementInput<Space, 1>& in, ForceBlocks<Space, 1>& out) const {
+    const Frame& body = in.body(0);
+    const Angular torque = torque_(in.t, body);
+    out.force[0].setZero();
+    out.force[0].template tail<Space::nw>() =
+        axes_ == Axes::body ? torque : body.torque_to_body(torque);
+  }
+
+ private:
+  static Function constant(const Angular& t) {
+    return [t](double, const Frame&) { return t; };
+  }
+  std::string name_;
+  std::array<BodyId, 1> bodies_;
+  Function torque_;
+  Axes axes_;
+};
+
+}  // namespace odyn

@@ -1,0 +1,12 @@
+#pragma once
+// odyn: multibody dynamics in which every body, joint and force is an object that computes its
+// own blocks of M v' + Phi_q^T lambda = Q, Phi(q, t) = 0. One include for everything.
+
+#include "odyn/analysis/assembly.hpp"
+#include "odyn/analysis/dynamics.hpp"
+#include "odyn/analysis/reactions.hpp"
+#include "odyn/analysis/system.hpp"
+#include "odyn/core/model.hpp"
+#include "odyn/core/workspace.hpp"
+#include "odyn/integrators/generalized_alpha.hpp"
+#include "odyn/spatial.hpp"

@@ -1,0 +1,35 @@
+#pragma once
+// The spatial element catalogue and the model types built from it.
+
+#include "odyn/core/model.hpp"
+#include "odyn/forces/gravity.hpp"
+#include "odyn/forces/point_load.hpp"
+#include "odyn/forces/tsda.hpp"
+#include "odyn/spatial/body.hpp"
+#include "odyn/spatial/cylindrical.hpp"
+#include "odyn/spatial/distance.hpp"
+#include "odyn/spatial/drivers.hpp"
+#include "odyn/spatial/fixed.hpp"
+#include "odyn/spatial/revolute.hpp"
+#include "odyn/spatial/rsda.hpp"
+#include "odyn/spatial/spherical.hpp"
+#include "odyn/spatial/translational.hpp"
+#include "odyn/spatial/universal.hpp"
+
+namespace odyn::spatial {
+
+using Gravity = GravityField<Spatial>;
+using PointForce = PointForceT<Spatial>;
+using PointTorque = PointTorqueT<Spatial>;
+using Tsda = TsdaT<Spatial>;
+
+/// A spatial model holding just the element types a scene lists.
+template <class... Elements>
+using Model = odyn::Model<Body, Elements...>;
+
+/// Every spatial element type of the library (what scripting uses).
+using DefaultModel =
+    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance,
+          RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
+
+}  // namespace odyn::spatial

@@ -1,0 +1,36 @@
+#pragma once
+// Cylindrical joint: the axes stay parallel and body b's point stays on body a's axis; b may
+// slide along and turn about it. 4 equations.
+
+#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/primitives.hpp"
+
+namespace odyn::spatial {
+
+class Cylindrical : public PairJoint {
+ public:
+  static constexpr int num_equations = 4;
+  using PairJoint::PairJoint;
+
+  void evaluate(const Input& in, BlocksOf<Cylindrical>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::dot1(a, on_a_.u, b, on_b_.w, out, 0);
+    primitive::dot1(a, on_a_.v, b, on_b_.w, out, 1);
+    primitive::dot2(a, on_a_.u, on_a_.point, b, on_b_.point, out, 2);
+    primitive::dot2(a, on_a_.v, on_a_.point, b, on_b_.point, out, 3);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Vector4d gamma(const Input& in) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    Eigen::Vector4d g;
+    g << primitive::dot1_gamma(a, on_a_.u, b, on_b_.w),
+        primitive::dot1_gamma(a, on_a_.v, b, on_b_.w),
+        primitive::dot2_gamma(a, on_a_.u, on_a_.point, b, on_b_.point),
+        primitive::dot2_gamma(a, on_a_.v, on_a_.point, b, on_b_.point);
+    return g;
+  }
+};
+static_assert(Constraint<Cylindrical>);
+
+}  // namespace odyn::spatial

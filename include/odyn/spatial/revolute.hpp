@@ -1,0 +1,33 @@
+#pragma once
+// Revolute (hinge): the joint points coincide and the axes stay parallel. 5 equations.
+
+#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/primitives.hpp"
+
+namespace odyn::spatial {
+
+class Revolute : public PairJoint {
+ public:
+  static constexpr int num_equations = 5;
+  using PairJoint::PairJoint;
+
+  void evaluate(const Input& in, BlocksOf<Revolute>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::spherical(a, on_a_.point, b, on_b_.point, out, 0);
+    primitive::dot1(a, on_a_.u, b, on_b_.w, out, 3);
+    primitive::dot1(a, on_a_.v, b, on_b_.w, out, 4);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Matrix<double, 5, 1> gamma(const Input& in) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    Eigen::Matrix<double, 5, 1> g;
+    g << primitive::spherical_gamma(a, on_a_.point, b, on_b_.point),
+        primitive::dot1_gamma(a, on_a_.u, b, on_b_.w),
+        primitive::dot1_gamma(a, on_a_.v, b, on_b_.w);
+    return g;
+  }
+};
+static_assert(Constraint<Revolute>);
+
+}  // namespace odyn::spatial

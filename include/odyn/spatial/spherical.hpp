@@ -1,0 +1,28 @@
+#pragma once
+// Spherical (ball) joint: the joint points coincide. 3 equations.
+
+#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/primitives.hpp"
+
+namespace odyn::spatial {
+
+class Spherical : public PairJoint {
+ public:
+  static constexpr int num_equations = 3;
+
+  Spherical(std::string name, BodyId body_a, const Eigen::Vector3d& point_a, BodyId body_b,
+            const Eigen::Vector3d& point_b)
+      : PairJoint(std::move(name), body_a, JointFrame{point_a}, body_b, JointFrame{point_b}) {}
+
+  void evaluate(const Input& in, BlocksOf<Spherical>& out) const {
+    primitive::spherical(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Vector3d gamma(const Input& in) const {
+    return primitive::spherical_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
+  }
+};
+static_assert(Constraint<Spherical>);
+
+}  // namespace odyn::spatial

@@ -1,0 +1,38 @@
+#pragma once
+// Translational (prismatic) joint: a cylindrical joint that also keeps the bodies from turning
+// about the axis; body b slides along body a's axis. 5 equations.
+
+#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/primitives.hpp"
+
+namespace odyn::spatial {
+
+class Translational : public PairJoint {
+ public:
+  static constexpr int num_equations = 5;
+  using PairJoint::PairJoint;
+
+  void evaluate(const Input& in, BlocksOf<Translational>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::dot1(a, on_a_.u, b, on_b_.w, out, 0);
+    primitive::dot1(a, on_a_.v, b, on_b_.w, out, 1);
+    primitive::dot2(a, on_a_.u, on_a_.point, b, on_b_.point, out, 2);
+    primitive::dot2(a, on_a_.v, on_a_.point, b, on_b_.point, out, 3);
+    primitive::dot1(a, on_a_.u, b, on_b_.v, out, 4);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Matrix<double, 5, 1> gamma(const Input& in) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    Eigen::Matrix<double, 5, 1> g;
+    g << primitive::dot1_gamma(a, on_a_.u, b, on_b_.w),
+        primitive::dot1_gamma(a, on_a_.v, b, on_b_.w),
+        primitive::dot2_gamma(a, on_a_.u, on_a_.point, b, on_b_.point),
+        primitive::dot2_gamma(a, on_a_.v, on_a_.point, b, on_b_.point),
+        primitive::dot1_gamma(a, on_a_.u, b, on_b_.v);
+    return g;
+  }
+};
+static_assert(Constraint<Translational>);
+
+}  // namespace odyn::spatial

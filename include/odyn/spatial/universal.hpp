@@ -1,0 +1,43 @@
+#pragma once
+// Universal (Cardan, Hooke) joint: the joint points coincide and the cross's two axes, one on
+// each body, stay perpendicular. 4 equations.
+
+#include <cmath>
+
+#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/primitives.hpp"
+
+namespace odyn::spatial {
+
+class Universal : public PairJoint {
+ public:
+  static constexpr int num_equations = 4;
+  using PairJoint::PairJoint;
+
+  void bind(const Input& in) {
+    PairJoint::bind(in);
+    const double alignment = in.body(0).direction(on_a_.w).dot(in.body(1).direction(on_b_.w));
+    if (std::abs(alignment) > 1.0 - 1e-9)
+      throw ModelError(name_,
+                       "the axes on body a and body b are parallel at the initial pose; "
+                       "a universal joint needs two perpendicular axes");
+  }
+
+  void evaluate(const Input& in, BlocksOf<Universal>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::spherical(a, on_a_.point, b, on_b_.point, out, 0);
+    primitive::dot1(a, on_a_.w, b, on_b_.w, out, 3);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Vector4d gamma(const Input& in) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    Eigen::Vector4d g;
+    g << primitive::spherical_gamma(a, on_a_.point, b, on_b_.point),
+        primitive::dot1_gamma(a, on_a_.w, b, on_b_.w);
+    return g;
+  }
+};
+static_assert(Constraint<Universal>);
+
+}  // namespace odyn::spatial
