@@ -26,7 +26,10 @@ struct Parameters {
 };
 
 /// Otto-cycle gas force on the piston along Z. It reads the crank angle theta from the crank's
-/// rotation about X and keeps the cumulative angle (the cycle spans two turns) as its state.
+/// rotation about X; its state keeps the cumulative angle and the half-turn the cycle is in
+/// (intake, compression, power, exhaust), which fixes the pressure law for a whole step. Its
+/// event function tells the integrator where the next half-turn starts, so that no step
+/// straddles ignition or the exhaust valve opening.
 class GasForce {
  public:
   using Space = odyn::Spatial;
@@ -34,6 +37,7 @@ class GasForce {
   using Input = odyn::ElementInput<Space, 2>;
   struct State {
     double theta = 0.0;  // cumulative crank angle at the last accepted step
+    long half_turn = 0;  // the stroke is half_turn mod 4
   };
 
   GasForce(std::string name, odyn::BodyId crank, odyn::BodyId piston, Parameters p)
@@ -42,8 +46,21 @@ class GasForce {
   const std::string& name() const { return name_; }
   const std::array<odyn::BodyId, 2>& bodies() const { return bodies_; }
 
-  State initial_state(const Input& in) const { return {wrapped_angle(in)}; }
-  void advance(const Input& in, State& state) const { state.theta = angle(in, state); }
+  State initial_state(const Input& in) const {
+    const double theta = wrapped_angle(in);
+    return {theta, static_cast<long>(std::floor(theta / std::numbers::pi))};
+  }
+
+  void advance(const Input& in, State& state) const {
+    state.theta = angle(in, state);
+    while (state.theta >= static_cast<double>(state.half_turn + 1) * std::numbers::pi)
+      ++state.half_turn;
+  }
+
+  /// Negative until the crank reaches the next half-turn.
+  double event_function(const Input& in, const State& state) const {
+    return angle(in, state) - static_cast<double>(state.half_turn + 1) * std::numbers::pi;
+  }
 
   /// Cumulative crank angle, continuous from the state (a step turns far less than pi).
   double angle(const Input& in, const State& state) const {
@@ -53,22 +70,22 @@ class GasForce {
   }
 
   void evaluate(const Input& in, const State& state, odyn::ForceBlocks<Space, 2>& out) const {
-    const double z_piston = in.body(1).position.z();
     out.force[0].setZero();
     out.force[1].setZero();
-    out.force[1][2] = force(angle(in, state), z_piston);
+    out.force[1][2] = force(stroke(state.half_turn), in.body(1).position.z());
   }
 
-  /// F_z = -(P - P_atm) A with the four strokes of the cycle phi = theta mod 4 pi.
-  double force(double theta, double z_piston) const {
-    const double pi = std::numbers::pi;
-    const double phi = theta - 4.0 * pi * std::floor(theta / (4.0 * pi));
+  /// The stroke (0 intake, 1 compression, 2 power, 3 exhaust) of a half-turn count.
+  static int stroke(long half_turn) { return static_cast<int>(((half_turn % 4) + 4) % 4); }
+
+  /// F_z = -(P - P_atm) A, with the pressure law of the stroke.
+  double force(int stroke, double z_piston) const {
     const double area = p_.area(), v_c = p_.clearance_volume();
     const double volume = v_c + area * ((p_.r + p_.L) - z_piston);
     double pressure = p_.p_atm;
-    if (phi >= pi && phi < 2.0 * pi)
+    if (stroke == 1)
       pressure = p_.p_atm * std::pow((v_c + 2.0 * p_.r * area) / volume, p_.kappa);
-    else if (phi >= 2.0 * pi && phi < 3.0 * pi)
+    else if (stroke == 2)
       pressure =
           (p_.p_atm * std::pow(p_.C, p_.kappa) + p_.p_comb) * std::pow(v_c / volume, p_.kappa);
     return -(pressure - p_.p_atm) * area;
@@ -83,7 +100,7 @@ class GasForce {
   std::array<odyn::BodyId, 2> bodies_;
   Parameters p_;
 };
-static_assert(odyn::StatefulForce<GasForce>);
+static_assert(odyn::HasEvents<GasForce>);
 
 /// Just the element types the engine uses: nothing else is compiled or dispatched.
 using Model = odyn::spatial::Model<odyn::spatial::Revolute, odyn::spatial::Spherical,

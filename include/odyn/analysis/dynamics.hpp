@@ -42,6 +42,52 @@ std::pair<double, double> constraint_residuals(const Model& model, const Workspa
   return {ws.phi.norm(), velocity_residual.norm()};
 }
 
+/// Advances the integrator to `t_target` in equal steps no longer than `max_step`. A step in
+/// which an element's event function crosses zero is cut back to end on the switch (found by
+/// the Illinois variant of regula falsi on the step size), then the integrator restarts.
+template <class Model, class Integrator>
+void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator, double t_target,
+                double max_step, double event_time_tolerance = 1e-12) {
+  while (integrator.time() < t_target - 1e-12 * std::max(1.0, std::abs(t_target))) {
+    const double remaining = t_target - integrator.time();
+    const double steps = std::ceil(remaining / max_step - 1e-9);
+    const double h = remaining / std::max(1.0, steps);
+    double g_start = 0.0;
+    if constexpr (has_events<Model>()) g_start = event_function(model, ws);
+    if (!integrator.attempt(h)) integrator.fail();
+    if constexpr (has_events<Model>()) {
+      double g_end = event_function(model, ws);
+      if (g_end >= 0.0 && g_start < 0.0) {
+        // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi).
+        double lo = 0.0, hi = h, g_lo = g_start, g_hi = g_end;
+        int stale_side = 0;
+        while (hi - lo > event_time_tolerance) {
+          double trial = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+          if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
+          if (!integrator.attempt(trial)) integrator.fail();
+          const double g = event_function(model, ws);
+          if (g >= 0.0) {
+            hi = trial, g_hi = g;
+            if (stale_side == 1) g_lo *= 0.5;  // Illinois: keep the other end moving
+            stale_side = 1;
+          } else {
+            lo = trial, g_lo = g;
+            if (stale_side == -1) g_hi *= 0.5;
+            stale_side = -1;
+          }
+        }
+        // End just past the switch, so that the element moves on to its next law.
+        if (!integrator.attempt(hi)) integrator.fail();
+        integrator.commit();
+        integrator.restart();
+        integrator.count_event();
+        continue;
+      }
+    }
+    integrator.commit();
+  }
+}
+
 /// Runs a dynamic analysis from the workspace's state (assembled first). `observe(ws)` sees the
 /// workspace at t0 and at every output time, with frames and element blocks up to date.
 template <class Model, class Observer>
@@ -64,7 +110,6 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   GeneralizedAlphaSettings integrator_settings = s.generalized_alpha;
   integrator_settings.hht = s.integrator == "hht";
   GeneralizedAlpha<Model> integrator(model, ws, integrator_settings);
-  integrator.initialize();
 
   auto record = [&] {
     const auto [phi_norm, phid_norm] = constraint_residuals(model, ws);
@@ -74,15 +119,10 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
     observe(std::as_const(ws));
   };
   record();
-  // Whole number of steps per output interval, none longer than the requested step.
-  const long steps_per_output =
-      std::max(1L, static_cast<long>(std::ceil(s.output_interval / s.step - 1e-9)));
-  const double h = s.output_interval / static_cast<double>(steps_per_output);
   const double t0 = ws.t;
   const long outputs = static_cast<long>(std::floor((s.t_end - t0) / s.output_interval + 1e-9));
   for (long k = 1; k <= outputs; ++k) {
-    for (long i = 0; i < steps_per_output; ++i) integrator.step(h);
-    ws.t = t0 + static_cast<double>(k) * s.output_interval;  // no drift from summing h
+    advance_to(model, ws, integrator, t0 + static_cast<double>(k) * s.output_interval, s.step);
     record();
   }
   summary.statistics = integrator.statistics();

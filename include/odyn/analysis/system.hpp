@@ -5,7 +5,9 @@
 // their own blocks and the stages scatter them, so no stage knows any element type.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "odyn/core/element.hpp"
 #include "odyn/core/model.hpp"
@@ -223,6 +225,30 @@ void initialize_states(const Model& model, Workspace<Model>& ws) {
         states[i] = pool[i].initial_state(detail::input_of(pool[i], ws.frames, ws.t));
     }
   });
+}
+
+/// True if some element type of the model declares events (known at compile time).
+template <class Model>
+constexpr bool has_events() {
+  return []<class B, class... E>(const odyn::Model<B, E...>*) {
+    return (HasEvents<E> || ...);
+  }(static_cast<const Model*>(nullptr));
+}
+
+/// Largest event function of all elements at the workspace's frames: it reaches zero when the
+/// first element switches its law. -infinity if there are none.
+template <class Model>
+double event_function(const Model& model, const Workspace<Model>& ws) {
+  double largest = -std::numeric_limits<double>::infinity();
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (HasEvents<E>) {
+      const auto& states = std::get<type>(ws.states);
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        largest = std::max(largest, static_cast<double>(pool[i].event_function(
+                                        detail::input_of(pool[i], ws.frames, ws.t), states[i])));
+    }
+  });
+  return largest;
 }
 
 template <class Model>

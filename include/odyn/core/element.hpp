@@ -89,6 +89,16 @@ concept StatefulForce = NamedElement<E> &&
 template <class E>
 concept ForceElement = StatelessForce<E> || StatefulForce<E>;
 
+/// Optional: a stateful force whose law switches abruptly (a valve opening, a contact closing).
+/// event_function(in, state) is negative before the next switch and reaches zero at it. The
+/// force keeps the law its state names for the whole step, so the integrator ends a step
+/// exactly at the switch; advance() then moves the state to the next law.
+template <class E>
+concept HasEvents = StatefulForce<E> &&
+    requires(const E& e, const InputOf<E>& in, const typename E::State& state) {
+  { e.event_function(in, state) } -> std::convertible_to<double>;
+};
+
 /// A force that acts on every body alike, such as gravity.
 template <class E>
 concept FieldForce = requires(const E& e, double mass, const typename E::Space::Frame& frame) {

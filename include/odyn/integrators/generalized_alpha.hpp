@@ -17,7 +17,7 @@
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
-#include "odyn/linalg/dense_lu.hpp"
+#include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
 
@@ -26,7 +26,7 @@ struct GeneralizedAlphaSettings {
   double rho_inf = 0.9;
   /// HHT-alpha flavour (alpha_m = 0, rho_inf in [0.5, 1]) instead of Chung-Hulbert's.
   bool hht = false;
-  /// Newton stops when the velocity correction is below atol + rtol |v| in every entry...
+  /// Newton stops when the velocity correction is below atol + rtol max|v| in every entry...
   double newton_rtol = 1e-9;
   double newton_atol = 1e-10;
   /// ... and |Phi| is below this in every entry.
@@ -42,9 +42,11 @@ struct IntegratorStatistics {
   long factorizations = 0;
   long residual_evaluations = 0;
   long rejected_steps = 0;
+  long restarts = 0;  // after discontinuities
+  long events = 0;    // located switches of force laws
 };
 
-template <class Model, class LinearSolver = DenseLu>
+template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
 class GeneralizedAlpha {
  public:
   using Settings = GeneralizedAlphaSettings;
@@ -71,54 +73,140 @@ class GeneralizedAlpha {
     nv_total_ = model.num_velocities();
     m_ = model.num_equations();
     const int n = nv_total_ + m_;
-    matrix_ = Eigen::MatrixXd::Zero(n, n);
     residual_ = Eigen::VectorXd::Zero(n);
     correction_ = Eigen::VectorXd::Zero(n);
-    q_n_ = ws.q;
-    v_n_ = ws.v;
-    vdot_n_ = ws.vdot;
-    a_n_ = ws.vdot;
     increment_ = Eigen::VectorXd::Zero(nv_total_);
-    solver_.analyze_pattern(matrix_);
+    jerk_ = Eigen::VectorXd::Zero(nv_total_);
+    solver_.analyze(model);
+    initialize();
   }
 
   /// Starts from the workspace's state, which must be consistent (see assemble) with v' and
   /// lambda solved from it: a_0 = v'_0.
   void initialize() {
+    t_n_ = ws_.t;
     q_n_ = ws_.q;
     v_n_ = ws_.v;
     vdot_n_ = ws_.vdot;
     a_n_ = ws_.vdot;
     lambda_n_ = ws_.lambda;
-    factorized_ = false;
+    vdot_previous_ = vdot_n_;
+    lambda_previous_ = lambda_n_;
+    restart();
   }
 
   /// Advances the workspace by one step of size h. Throws SolverError if Newton fails.
   void step(double h) {
-    if (h != h_) {
-      h_ = h;
-      factorized_ = false;
-    }
-    const double t_new = ws_.t + h;
+    if (!attempt(h)) fail();
+    commit();
+  }
+
+  /// Tries a step of size h from the last committed state; the workspace then holds the trial
+  /// state (frames and blocks evaluated there). False if Newton failed even with a fresh matrix.
+  bool attempt(double h) {
+    h_ = h;
+    if (starting_) a_n_ = vdot_n_ + (alpha_m_ - alpha_f_) * h * jerk_;
+    const double t_new = t_n_ + h;
     for (int attempt = 0; attempt < 2; ++attempt) {
       const bool fresh = !factorized_;
-      if (solve_step(t_new)) {
-        accept(t_new);
-        return;
-      }
+      if (solve_step(t_new)) return true;
       // A stale factorization may be the cause: retry once with a fresh one.
       ++statistics_.rejected_steps;
       factorized_ = false;
       if (fresh) break;
     }
-    restore();
-    throw SolverError(t_new, failure_message());
+    return false;
   }
 
+  /// Accepts the trial state of the last successful attempt.
+  void commit() {
+    a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_n_) / (1.0 - alpha_m_);
+    vdot_previous_ = vdot_n_;
+    lambda_previous_ = lambda_n_;
+    previous_step_ = h_;
+    starting_ = false;
+    q_n_ = ws_.q;
+    v_n_ = ws_.v;
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    t_n_ = ws_.t;
+    advance_states(model_, ws_);
+    ++statistics_.steps;
+  }
+
+  /// Restarts after a discontinuity of the forces (and at the start of a run): v' and lambda
+  /// consistent with the committed state, and the perturbed starting value of Arnold & Bruls,
+  ///   a_n = v'_n + (alpha_m - alpha_f) h v''_n,
+  /// which keeps the index-3 scheme free of the spurious O(h) oscillations that a_n = v'_n
+  /// starts in v' and lambda. v'' comes from consistent accelerations a short time later.
+  void restart() {
+    consistent_accelerations();
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    // A short Taylor step along the motion, then v'' by a finite difference.
+    const double delta = 1e-6 * std::max(std::abs(t_n_), 1.0) + (h_ > 0.0 ? 1e-2 * h_ : 0.0);
+    increment_ = delta * v_n_ + 0.5 * delta * delta * vdot_n_;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::integrate(q_n_.template segment<nq>(b * nq),
+                              increment_.template segment<nv>(b * nv),
+                              ws_.q.template segment<nq>(b * nq));
+    ws_.v = v_n_ + delta * vdot_n_;
+    ws_.t = t_n_ + delta;
+    consistent_accelerations();
+    jerk_ = (ws_.vdot - vdot_n_) / delta;
+    a_n_ = vdot_n_;
+    starting_ = true;
+    previous_step_ = 0.0;  // no extrapolation across the discontinuity
+    ++statistics_.restarts;
+    rollback();
+  }
+
+  /// Puts the workspace back at the last committed state.
+  void rollback() {
+    ws_.q = q_n_;
+    ws_.v = v_n_;
+    ws_.vdot = vdot_n_;
+    ws_.lambda = lambda_n_;
+    ws_.t = t_n_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+  }
+
+  /// Rolls back and throws the SolverError that describes the last failed attempt.
+  [[noreturn]] void fail() {
+    const std::string message = failure_message();
+    const double t_failed = t_n_ + h_;
+    rollback();
+    throw SolverError(t_failed, message);
+  }
+
+  double time() const { return t_n_; }
+  void count_event() { ++statistics_.events; }
   const IntegratorStatistics& statistics() const { return statistics_; }
   const Settings& settings() const { return settings_; }
 
  private:
+  /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the workspace's
+  /// state. Uses the iteration matrix's storage; the next step factorizes afresh.
+  void consistent_accelerations() {
+    const int n = nv_total_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+    evaluate_gamma(model_, ws_);
+    ++statistics_.factorizations;
+    factorized_ = false;
+    if (!solver_.factorize(model_, ws_, IterationFactors{}))
+      throw SolverError(ws_.t,
+                        "the mass-constraint matrix is singular; check for redundant or "
+                        "locked constraints");
+    residual_.head(n) = ws_.force;
+    residual_.tail(m_) = ws_.gamma;
+    solver_.solve(residual_, correction_);
+    ws_.vdot = correction_.head(n);
+    ws_.lambda = correction_.tail(m_);
+  }
+
   /// The state at t_{n+1} from the current guess of v'_{n+1}, written into the workspace.
   void update_state(double t_new) {
     const double h = h_;
@@ -155,23 +243,27 @@ class GeneralizedAlpha {
 
   bool factorize() {
     ++statistics_.factorizations;
-    matrix_.setZero();
-    add_iteration_blocks(model_, ws_, matrix_, 1.0, position_factor(), velocity_factor());
-    write_jacobian(model_, ws_, matrix_, nv_total_, 0, true);
-    factorized_ = solver_.factorize(matrix_);
-    iterations_since_factorization_ = 0;
+    factorized_ =
+        solver_.factorize(model_, ws_, IterationFactors{1.0, position_factor(), velocity_factor()});
     return factorized_;
   }
 
   bool solve_step(double t_new) {
-    // Predictor: the last acceleration and multipliers.
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
+    // Predictor: v' and lambda extrapolated linearly from the last two steps.
+    if (previous_step_ > 0.0) {
+      const double ratio = h_ / previous_step_;
+      ws_.vdot = vdot_n_ + ratio * (vdot_n_ - vdot_previous_);
+      ws_.lambda = lambda_n_ + ratio * (lambda_n_ - lambda_previous_);
+    } else {
+      ws_.vdot = vdot_n_;
+      ws_.lambda = lambda_n_;
+    }
     update_state(t_new);
     double previous_norm = 0.0;
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
-      if (k > 0 && last_norm_ <= 1.0 &&
+      // Converged when the last correction was within tolerance and Phi is satisfied.
+      if (k > 0 && previous_norm <= 1.0 &&
           ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance) {
         if (k > settings_.reuse_iterations) factorized_ = false;
         return true;
@@ -183,39 +275,15 @@ class GeneralizedAlpha {
       ws_.lambda -= correction_.tail(m_);
       ++statistics_.newton_iterations;
       // Size of the velocity correction in units of the tolerance.
-      last_norm_ = 0.0;
-      const double scale = velocity_factor();
-      for (int i = 0; i < nv_total_; ++i)
-        last_norm_ = std::max(
-            last_norm_, scale * std::abs(correction_[i]) /
-                            (settings_.newton_atol + settings_.newton_rtol * std::abs(ws_.v[i])));
-      if (k > 0 && last_norm_ > 2.0 * previous_norm && last_norm_ > 1.0) return false;
-      previous_norm = last_norm_;
+      const double norm =
+          velocity_factor() * correction_.head(nv_total_).cwiseAbs().maxCoeff() /
+          (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff());
+      if (!std::isfinite(norm)) return false;
+      if (k > 0 && norm > 2.0 * previous_norm && norm > 1.0) return false;  // diverging
+      previous_norm = norm;
       update_state(t_new);
     }
     return false;
-  }
-
-  void accept(double t_new) {
-    a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_n_) / (1.0 - alpha_m_);
-    q_n_ = ws_.q;
-    v_n_ = ws_.v;
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
-    ws_.t = t_new;
-    advance_states(model_, ws_);
-    ++statistics_.steps;
-  }
-
-  /// Puts the workspace back at the start of the failed step.
-  void restore() {
-    const double t_failed = ws_.t;
-    ws_.q = q_n_;
-    ws_.v = v_n_;
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
-    ws_.t = t_failed - h_;
-    update_frames(model_, ws_);
   }
 
   std::string failure_message() const {
@@ -245,17 +313,19 @@ class GeneralizedAlpha {
   Settings settings_;
   double alpha_m_ = 0.0, alpha_f_ = 0.0, gamma_ = 0.5, beta_ = 0.25;
   double h_ = 0.0;
+  double t_n_ = 0.0;
   int nv_total_ = 0, m_ = 0;
   bool factorized_ = false;
-  int iterations_since_factorization_ = 0;
-  double last_norm_ = 0.0;
 
-  Eigen::MatrixXd matrix_;      // (n x n) iteration matrix, n = nv_total + m
-  Eigen::VectorXd residual_;    // (n)
-  Eigen::VectorXd correction_;  // (n)
+  Eigen::VectorXd residual_;                             // (n)
+  Eigen::VectorXd correction_;                           // (n)
   Eigen::VectorXd q_n_, v_n_, vdot_n_, a_n_, lambda_n_;  // state at the start of the step
-  Eigen::VectorXd increment_;                            // (nv_total) configuration increment
-  LinearSolver solver_;
+  Eigen::VectorXd vdot_previous_, lambda_previous_;      // one step earlier, for the predictor
+  double previous_step_ = 0.0;                           // its size; 0 after a (re)start
+  Eigen::VectorXd jerk_;                                 // (nv_total) v'' at the last restart
+  bool starting_ = false;      // the next step is the first after a restart
+  Eigen::VectorXd increment_;  // (nv_total) configuration increment
+  Solver solver_;
   IntegratorStatistics statistics_;
 };
 
