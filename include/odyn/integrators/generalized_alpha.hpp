@@ -77,6 +77,10 @@ class GeneralizedAlpha {
     correction_ = Eigen::VectorXd::Zero(n);
     increment_ = Eigen::VectorXd::Zero(nv_total_);
     jerk_ = Eigen::VectorXd::Zero(nv_total_);
+    inverse_mass_diagonal_ = Eigen::VectorXd::Zero(nv_total_);
+    for (int b = 1; b <= model.num_bodies(); ++b)
+      inverse_mass_diagonal_.template segment<nv>((b - 1) * nv) =
+          model.body(BodyId{b}).mass_block().diagonal().cwiseInverse();
     solver_.analyze(model);
     initialize();
   }
@@ -262,8 +266,17 @@ class GeneralizedAlpha {
     double previous_norm = 0.0;
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
-      // Converged when the last correction was within tolerance and Phi is satisfied.
-      if (k > 0 && previous_norm <= 1.0 &&
+      // Converged when Phi is satisfied and the last correction, or the next one as estimated
+      // from the residual, is within tolerance.
+      // The next correction is estimated from the residual with the mass matrix's diagonal.
+      const double next_norm =
+          k > 0 ? velocity_factor() *
+                      (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_))
+                          .cwiseAbs()
+                          .maxCoeff() /
+                      (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff())
+                : 0.0;
+      if (k > 0 && (previous_norm <= 1.0 || next_norm <= 1.0) &&
           ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance) {
         if (k > settings_.reuse_iterations) factorized_ = false;
         return true;
@@ -322,6 +335,7 @@ class GeneralizedAlpha {
   Eigen::VectorXd q_n_, v_n_, vdot_n_, a_n_, lambda_n_;  // state at the start of the step
   Eigen::VectorXd vdot_previous_, lambda_previous_;      // one step earlier, for the predictor
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start
+  Eigen::VectorXd inverse_mass_diagonal_;                // (nv_total)
   Eigen::VectorXd jerk_;                                 // (nv_total) v'' at the last restart
   bool starting_ = false;      // the next step is the first after a restart
   Eigen::VectorXd increment_;  // (nv_total) configuration increment

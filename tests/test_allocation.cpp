@@ -1,0 +1,45 @@
+// A time step allocates nothing: every buffer lives in the workspace and the integrator,
+// sized once. Global operator new is replaced here to count heap allocations.
+
+#include <catch2/catch.hpp>
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "engine_model.hpp"
+
+namespace test_allocation {
+std::atomic<long> allocations{0};
+std::atomic<bool> counting{false};
+}  // namespace test_allocation
+
+// GCC cannot see that these replacements pair malloc with free.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  if (test_allocation::counting) ++test_allocation::allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace test_allocation {
+
+TEST_CASE("a time step allocates nothing, events and restarts included", "[workspace]") {
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  odyn::GeneralizedAlpha<engine::Model> integrator(e.model, ws);
+  for (int i = 0; i < 10; ++i) integrator.step(1e-4);  // warm up
+  allocations = 0;
+  counting = true;
+  // 0.05 s takes the crank through ignition: event location and a restart happen here.
+  odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+  counting = false;
+  CHECK(integrator.statistics().events >= 2);
+  CHECK(allocations == 0);
+}
+
+}  // namespace test_allocation
