@@ -10,6 +10,7 @@
 //    complement B A^-1 B^T; several times cheaper for small and medium models. It falls back
 //    to the dense solver by itself when A is not block diagonal.
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <vector>
@@ -87,6 +88,7 @@ class BlockSchurSaddlePoint {
  public:
   static constexpr int nv = Model::nv;
   using Block = Eigen::Matrix<double, nv, nv>;
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, nv>;
 
   void analyze(const Model& model) {
     dense_fallback_ = detail::couples_bodies(model);
@@ -98,10 +100,30 @@ class BlockSchurSaddlePoint {
     n_ = model.num_velocities();
     m_ = model.num_equations();
     blocks_.assign(bodies_, Block::Zero());
-    block_lu_.assign(bodies_, Eigen::PartialPivLU<Block>(nv));
+    inverses_.assign(bodies_, Block::Zero());
+    // The constraint rows that act on each body: S = B A^-1 B^T only couples those.
+    rows_.assign(bodies_, {});
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+      if constexpr (Constraint<E>) {
+        for (std::size_t i = 0; i < pool.size(); ++i)
+          for (const BodyId body : pool[i].bodies())
+            if (!body.is_ground())
+              for (int r = 0; r < E::num_equations; ++r)
+                rows_[body.index - 1].push_back(model.template rows<E>()[i] + r);
+      }
+    });
+    gathered_.clear();
+    weighted_.clear();
+    local_.clear();
+    for (const auto& rows : rows_) {
+      const auto size = static_cast<Eigen::Index>(rows.size());
+      gathered_.emplace_back(Rows::Zero(size, nv));
+      weighted_.emplace_back(Rows::Zero(size, nv));
+      local_.emplace_back(Eigen::MatrixXd::Zero(size, size));
+    }
     jacobian_ = Eigen::MatrixXd::Zero(m_, n_);
-    a_inverse_jacobian_t_ = Eigen::MatrixXd::Zero(n_, m_);
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
+    schur_llt_ = Eigen::LLT<Eigen::MatrixXd>(m_);
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
     work_n_ = Eigen::VectorXd::Zero(n_);
     work_m_ = Eigen::VectorXd::Zero(m_);
@@ -115,43 +137,65 @@ class BlockSchurSaddlePoint {
     detail::BlockDiagonalView<nv> view{&blocks_};
     add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping);
     write_jacobian(model, ws, jacobian_, 0, 0, false);
-    // W = A^-1 B^T body by body, then S = B W.
+    schur_.setZero();
     for (int b = 0; b < bodies_; ++b) {
-      block_lu_[b].compute(blocks_[b]);
-      if (!(block_lu_[b].matrixLU().diagonal().cwiseAbs().minCoeff() > 0.0)) return false;
-      a_inverse_jacobian_t_.middleRows<nv>(b * nv).noalias() =
-          block_lu_[b].solve(jacobian_.middleCols<nv>(b * nv).transpose());
+      // Gyroscopic damping makes A slightly unsymmetric; Cholesky then needs its symmetric
+      // part, which only slows Newton's convergence a little, never its result.
+      inverses_[b] = (0.5 * (blocks_[b] + blocks_[b].transpose())).inverse();
+      if (!inverses_[b].allFinite()) return false;
+      if (rows_[b].empty()) continue;
+      const auto& rows = rows_[b];
+      const auto size = static_cast<Eigen::Index>(rows.size());
+      for (Eigen::Index i = 0; i < size; ++i)
+        gathered_[b].row(i) = jacobian_.block<1, nv>(rows[i], b * nv);
+      weighted_[b].noalias() = gathered_[b] * inverses_[b];
+      local_[b].noalias() = weighted_[b] * gathered_[b].transpose();
+      for (Eigen::Index j = 0; j < size; ++j)
+        for (Eigen::Index i = 0; i < size; ++i) schur_(rows[i], rows[j]) += local_[b](i, j);
     }
     if (m_ == 0) return true;
-    schur_.noalias() = jacobian_ * a_inverse_jacobian_t_;
+    schur_llt_.compute(schur_);
+    use_lu_ = schur_llt_.info() != Eigen::Success;
+    if (!use_lu_) return true;
+    // Not positive definite (A itself is not): fall back to LU on the same matrix.
     schur_lu_.compute(schur_);
     const double largest = schur_lu_.matrixLU().cwiseAbs().maxCoeff();
     return schur_lu_.matrixLU().diagonal().cwiseAbs().minCoeff() > 1e-13 * largest;
   }
 
-  /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 f - W y.
+  /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
     if (dense_fallback_) return dense_.solve(rhs, solution);
     for (int b = 0; b < bodies_; ++b)
-      work_n_.segment<nv>(b * nv) = block_lu_[b].solve(rhs.segment<nv>(b * nv));
+      work_n_.segment<nv>(b * nv).noalias() = inverses_[b] * rhs.segment<nv>(b * nv);
     if (m_ > 0) {
       work_m_.noalias() = jacobian_ * work_n_;
       work_m_ -= rhs.tail(m_);
-      solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
-      work_n_.noalias() -= a_inverse_jacobian_t_ * solution.tail(m_);
+      if (use_lu_)
+        solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
+      else
+        solution.tail(m_).noalias() = schur_llt_.solve(work_m_);
+      work_n_.noalias() = rhs.head(n_) - jacobian_.transpose() * solution.tail(m_);
+      for (int b = 0; b < bodies_; ++b)
+        solution.segment<nv>(b * nv).noalias() = inverses_[b] * work_n_.segment<nv>(b * nv);
+    } else {
+      solution.head(n_) = work_n_;
     }
-    solution.head(n_) = work_n_;
   }
 
  private:
   bool dense_fallback_ = false;
   DenseSaddlePoint<Model> dense_;
   int bodies_ = 0, n_ = 0, m_ = 0;
-  std::vector<Block> blocks_;                         // (nb) diagonal blocks of A
-  std::vector<Eigen::PartialPivLU<Block>> block_lu_;  // (nb)
-  Eigen::MatrixXd jacobian_;                          // (m x n) B
-  Eigen::MatrixXd a_inverse_jacobian_t_;              // (n x m) W = A^-1 B^T
-  Eigen::MatrixXd schur_;                             // (m x m) S = B W
+  bool use_lu_ = false;
+  std::vector<Block> blocks_;              // (nb) diagonal blocks of A
+  std::vector<Block> inverses_;            // (nb) inverses of their symmetric parts
+  std::vector<std::vector<int>> rows_;     // (nb) constraint rows acting on each body
+  std::vector<Rows> gathered_, weighted_;  // (nb) B restricted to those rows, times A^-1
+  std::vector<Eigen::MatrixXd> local_;     // (nb) their contribution to S
+  Eigen::MatrixXd jacobian_;               // (m x n) B
+  Eigen::MatrixXd schur_;                  // (m x m) S = B A^-1 B^T
+  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
   Eigen::VectorXd work_n_, work_m_;
 };
