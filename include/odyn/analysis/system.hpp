@@ -197,10 +197,13 @@ void add_iteration_blocks(const Model& model, const Workspace<Model>& ws, Matrix
 template <class Model>
 void mass_times(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& x,
                 Eigen::Ref<Eigen::VectorXd> out) {
+  using Space = typename Model::Space;
   constexpr int nv = Model::nv;
-  for (int b = 1; b <= model.num_bodies(); ++b)
-    out.template segment<nv>((b - 1) * nv).noalias() =
-        model.body(BodyId{b}).mass_block() * x.template segment<nv>((b - 1) * nv);
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const auto& body = model.body(BodyId{b});
+    out.template segment<nv>((b - 1) * nv) =
+        Space::mass_times(body.mass, body.inertia, x.template segment<nv>((b - 1) * nv));
+  }
 }
 
 /// Stateful force elements take their step: called once per accepted step.

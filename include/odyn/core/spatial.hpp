@@ -137,6 +137,14 @@ struct Spatial {
     return m;
   }
 
+  /// M v for one body without forming M.
+  static Velocity mass_times(double mass, const Inertia& inertia, const Velocity& v) {
+    Velocity out;
+    out.head<3>() = mass * v.head<3>();
+    out.tail<3>().noalias() = inertia * v.tail<3>();
+    return out;
+  }
+
   /// Gyroscopic generalized force -w x (J w), which the body itself contributes to Q.
   static Velocity gyroscopic_force(const Inertia& inertia, const Frame& frame) {
     Velocity q = Velocity::Zero();
