@@ -90,8 +90,17 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
   using Space = typename Model::Space;
   constexpr int nq = Model::nq, nv = Model::nv;
   const int m = model.num_equations();
-  if (!ws.q.allFinite() || !ws.v.allFinite())
-    throw AssemblyError("initial state", "the initial state contains NaN or infinity");
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const std::string& name = model.body(BodyId{b}).name;
+    if (!ws.q.template segment<nq>((b - 1) * nq).allFinite())
+      throw AssemblyError(
+          name, "the initial state contains NaN or infinity: the pose of body '" + name + "'");
+    if (!ws.v.template segment<nv>((b - 1) * nv).allFinite())
+      throw AssemblyError(name,
+                          "the initial state contains NaN or infinity: the velocity of "
+                          "body '" +
+                              name + "'");
+  }
   auto residual_norm = [&] {
     update_frames(model, ws);
     evaluate_constraints(model, ws);
@@ -121,12 +130,20 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
     Eigen::Index row = 0;
     const double worst = m > 0 ? ws.phi.cwiseAbs().maxCoeff(&row) : 0.0;
     const std::string joint = m > 0 ? model.constraint_name(static_cast<int>(row)) : "";
-    throw AssemblyError(joint, "constraints could not be satisfied after " +
-                                   std::to_string(iteration) +
-                                   " Newton iterations; largest residual " + to_text(worst) +
-                                   " at joint '" + joint +
-                                   "'. Check its points and axes, or start from a pose closer "
-                                   "to an assembled one.");
+    // The least-squares compromise spreads the violation: list every joint left unsatisfied.
+    std::string others;
+    for (int r = 0; r < m; ++r) {
+      const std::string name = model.constraint_name(r);
+      if (std::abs(ws.phi[r]) > s.tolerance && name != joint &&
+          others.find("'" + name + "'") == std::string::npos)
+        others += (others.empty() ? "" : ", ") + ("'" + name + "'");
+    }
+    throw AssemblyError(
+        joint, "constraints could not be satisfied after " + std::to_string(iteration) +
+                   " Newton iterations; largest residual " + to_text(worst) + " at joint '" +
+                   joint + "'" + (others.empty() ? "" : "; also unsatisfied: " + others) +
+                   ". Check their points, axes and lengths, or start from a "
+                   "pose closer to an assembled one.");
   }
   return iteration;
 }

@@ -313,12 +313,30 @@ class GeneralizedAlpha {
       return "Newton iteration produced a non-finite value; " + culprit +
              " returned NaN or infinity. Check its parameters and inputs.";
     }
+    // The force element pushing hardest is the usual suspect when Newton diverges.
+    std::string strongest;
+    double strongest_force = 0.0;
+    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+      if constexpr (ForceElement<E>) {
+        const auto& blocks = std::get<type>(ws_.blocks);
+        for (std::size_t i = 0; i < pool.size(); ++i)
+          for (const auto& f : blocks[i].force)
+            if (f.norm() > strongest_force) {
+              strongest_force = f.norm();
+              strongest = pool[i].name();
+            }
+      }
+    });
     Eigen::Index row = 0;
     const double worst = m_ > 0 ? ws_.phi.cwiseAbs().maxCoeff(&row) : 0.0;
     return "Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
            " iterations (largest constraint residual " + to_text(worst) + " at '" +
-           (m_ > 0 ? model_.constraint_name(static_cast<int>(row)) : std::string("-")) +
-           "'). Reduce the step size, or check for a locked or singular mechanism.";
+           (m_ > 0 ? model_.constraint_name(static_cast<int>(row)) : std::string("-")) + "'" +
+           (strongest.empty() ? std::string()
+                              : ", largest applied force from '" + strongest + "' (" +
+                                    to_text(strongest_force) + ")") +
+           "). Reduce the step size, check the force elements' parameters, or look for a locked or "
+           "singular mechanism.";
   }
 
   const Model& model_;
