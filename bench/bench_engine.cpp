@@ -72,8 +72,8 @@ void Run(benchmark::State& state) {
     std::size_t k = 0;
     z_error = 0.0;
     const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& s) {
-      z_error = std::max(z_error, std::abs(s.frames[e.piston.index].position.z() -
-                                           reference[k++].z_piston));
+      z_error = std::max(z_error,
+                         std::abs(s.frames[e.piston.index].position.z() - reference[k++].z_piston));
     });
     theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     steps = summary.statistics.steps;
@@ -81,9 +81,9 @@ void Run(benchmark::State& state) {
   state.counters["theta_error"] = theta_error;
   state.counters["z_max_error"] = z_error;
   state.counters["steps"] = double(steps);
-  state.counters["us_per_step"] = benchmark::Counter(
-      double(steps) * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
-                                benchmark::Counter::kInvert);
+  state.counters["us_per_step"] =
+      benchmark::Counter(double(steps) * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
+                                                   benchmark::Counter::kInvert);
 }
 BENCHMARK(Run)->Arg(200)->Arg(100)->Arg(50)->Arg(25)->Unit(benchmark::kMillisecond);
 

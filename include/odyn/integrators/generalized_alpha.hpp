@@ -277,7 +277,7 @@ class GeneralizedAlpha {
                       (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff())
                 : 0.0;
       if (k > 0 && (previous_norm <= 1.0 || next_norm <= 1.0) &&
-          ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance) {
+          (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
         if (k > settings_.reuse_iterations) factorized_ = false;
         return true;
       }
