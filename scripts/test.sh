@@ -31,7 +31,8 @@ section "Release tests"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
 section "ASan + UBSan build (build-asan/)"
-configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DODYN_SANITIZE=ON \
+# -Og -g1 (line tables: enough for sanitizer stack traces) compiles twice as fast as -O1 -g here.
+configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 

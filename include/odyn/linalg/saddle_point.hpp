@@ -145,7 +145,7 @@ class BlockSchurSaddlePoint {
     }
     jacobian_ = Eigen::MatrixXd::Zero(m_, n_);
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
-    schur_llt_ = Eigen::LLT<Eigen::MatrixXd>(m_);
+    schur_llt_.compute(Eigen::MatrixXd::Identity(m_, m_));  // sizes it; info() defined
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
     work_n_ = Eigen::VectorXd::Zero(n_);
     work_m_ = Eigen::VectorXd::Zero(m_);
