@@ -13,6 +13,8 @@ std::atomic<long> allocations{0};
 std::atomic<bool> counting{false};
 }  // namespace test_allocation
 
+// AddressSanitizer owns operator new in its builds, so the count runs in the plain build only.
+#ifndef __SANITIZE_ADDRESS__
 // GCC cannot see that these replacements pair malloc with free.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
@@ -28,6 +30,7 @@ void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
 #pragma GCC diagnostic pop
+#endif
 
 namespace test_allocation {
 
@@ -43,7 +46,9 @@ TEST_CASE("a time step allocates nothing, events and restarts included", "[works
   odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
   counting = false;
   CHECK(integrator.statistics().events >= 2);
+#ifndef __SANITIZE_ADDRESS__
   CHECK(allocations == 0);
+#endif
 }
 
 }  // namespace test_allocation

@@ -239,8 +239,8 @@ FreeBodyRun run_free_body(double spin, double delta, double step, double t_end) 
   sp::Body brick{.name = "brick", .mass = 1.0, .inertia = inertia};
   brick.angular_velocity = {0.0, spin, delta * spin};
   const BodyId body = model.add_body(brick);
-  // A second body welded to the ground, apart from the brick: the brick stays free, but the model
-  // has constraint equations, which the integrator currently needs (see the hidden test below).
+  // A second body welded to the ground, apart from the brick: the brick stays free while the
+  // integrator also carries constraint rows (the model without any is tested below).
   const BodyId anchor = model.add_body({.name = "anchor",
                                         .mass = 1.0,
                                         .inertia = sp::Body::principal(1, 1, 1),
