@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "odyn/core/element.hpp"
 #include "odyn/core/model.hpp"
@@ -96,12 +97,11 @@ void evaluate_forces(const Model& model, Workspace<Model>& ws) {
   });
 }
 
-/// out += Phi_q^T y, from the element blocks of the last evaluate_constraints.
-template <class Model>
-void add_jacobian_transpose_times(const Model& model, const Workspace<Model>& ws,
-                                  const Eigen::Ref<const Eigen::VectorXd>& y,
-                                  Eigen::Ref<Eigen::VectorXd> out) {
-  constexpr int nv = Model::nv;
+namespace detail {
+/// Calls f(first_row, first_column, block) for every Jacobian block of a moving body, from the
+/// element blocks of the last evaluate_constraints; `block` has its element's fixed size.
+template <class Model, class F>
+void for_each_jacobian_block(const Model& model, const Workspace<Model>& ws, F&& f) {
   model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
     if constexpr (Constraint<E>) {
       const auto& blocks = std::get<type>(ws.blocks);
@@ -109,11 +109,22 @@ void add_jacobian_transpose_times(const Model& model, const Workspace<Model>& ws
       for (std::size_t i = 0; i < pool.size(); ++i)
         for (int k = 0; k < E::num_bodies; ++k) {
           const BodyId body = pool[i].bodies()[k];
-          if (!body.is_ground())
-            out.template segment<nv>(Model::velocity_offset(body)).noalias() +=
-                blocks[i].jacobian[k].transpose() * y.template segment<E::num_equations>(rows[i]);
+          if (!body.is_ground()) f(rows[i], Model::velocity_offset(body), blocks[i].jacobian[k]);
         }
     }
+  });
+}
+}  // namespace detail
+
+/// out += Phi_q^T y.
+template <class Model>
+void add_jacobian_transpose_times(const Model& model, const Workspace<Model>& ws,
+                                  const Eigen::Ref<const Eigen::VectorXd>& y,
+                                  Eigen::Ref<Eigen::VectorXd> out) {
+  detail::for_each_jacobian_block(model, ws, [&](int row, int column, const auto& block) {
+    constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
+    out.template segment<Model::nv>(column).noalias() +=
+        block.transpose() * y.template segment<m>(row);
   });
 }
 
@@ -121,43 +132,23 @@ void add_jacobian_transpose_times(const Model& model, const Workspace<Model>& ws
 template <class Model>
 void jacobian_times(const Model& model, const Workspace<Model>& ws,
                     const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> out) {
-  constexpr int nv = Model::nv;
   out.setZero();
-  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-    if constexpr (Constraint<E>) {
-      const auto& blocks = std::get<type>(ws.blocks);
-      const auto& rows = model.template rows<E>();
-      for (std::size_t i = 0; i < pool.size(); ++i)
-        for (int k = 0; k < E::num_bodies; ++k) {
-          const BodyId body = pool[i].bodies()[k];
-          if (!body.is_ground())
-            out.template segment<E::num_equations>(rows[i]).noalias() +=
-                blocks[i].jacobian[k] * x.template segment<nv>(Model::velocity_offset(body));
-        }
-    }
+  detail::for_each_jacobian_block(model, ws, [&](int row, int column, const auto& block) {
+    constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
+    out.template segment<m>(row).noalias() += block * x.template segment<Model::nv>(column);
   });
 }
 
-/// Writes Phi_q into `jacobian` at (row_offset, col_offset); `transposed` also writes Phi_q^T at
-/// (col_offset, row_offset) — the two off-diagonal blocks of a saddle-point matrix.
+/// Writes Phi_q into `target` at (row_offset, col_offset); `with_transpose` also writes Phi_q^T
+/// at (col_offset, row_offset): the two off-diagonal blocks of a saddle-point matrix.
 template <class Model, class Matrix>
 void write_jacobian(const Model& model, const Workspace<Model>& ws, Matrix& target, int row_offset,
                     int col_offset, bool with_transpose) {
-  constexpr int nv = Model::nv;
-  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-    if constexpr (Constraint<E>) {
-      const auto& blocks = std::get<type>(ws.blocks);
-      const auto& rows = model.template rows<E>();
-      for (std::size_t i = 0; i < pool.size(); ++i)
-        for (int k = 0; k < E::num_bodies; ++k) {
-          const BodyId body = pool[i].bodies()[k];
-          if (body.is_ground()) continue;
-          const int r = row_offset + rows[i], c = col_offset + Model::velocity_offset(body);
-          target.template block<E::num_equations, nv>(r, c) = blocks[i].jacobian[k];
-          if (with_transpose)
-            target.template block<nv, E::num_equations>(c, r) = blocks[i].jacobian[k].transpose();
-        }
-    }
+  detail::for_each_jacobian_block(model, ws, [&](int row, int column, const auto& block) {
+    constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
+    const int r = row_offset + row, c = col_offset + column;
+    target.template block<m, Model::nv>(r, c) = block;
+    if (with_transpose) target.template block<Model::nv, m>(c, r) = block.transpose();
   });
 }
 
