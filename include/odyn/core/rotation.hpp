@@ -24,15 +24,6 @@ inline Eigen::Quaterniond quaternion_exp(const Eigen::Vector3d& rotation_vector)
           sinc_half * rotation_vector.z()};
 }
 
-/// Rotation vector of a unit quaternion (inverse of quaternion_exp, angle in [0, pi]).
-inline Eigen::Vector3d quaternion_log(Eigen::Quaterniond q) {
-  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  const double sin_half = q.vec().norm();
-  const double angle = 2.0 * std::atan2(sin_half, q.w());
-  if (sin_half < 1e-12) return 2.0 * q.vec();
-  return q.vec() * (angle / sin_half);
-}
-
 /// Any unit vector perpendicular to the unit vector `axis` (deterministic choice).
 inline Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& axis) {
   // Cross with the coordinate axis least aligned with `axis` for good conditioning.

@@ -121,15 +121,6 @@ struct Spatial {
     q_out.tail<4>() << rotated.w(), rotated.x(), rotated.y(), rotated.z();
   }
 
-  /// Tangent-space difference log(q_a^-1 q_b) (inverse of integrate), for finite differences.
-  static Velocity difference(const Eigen::Ref<const Configuration>& q_a,
-                             const Eigen::Ref<const Configuration>& q_b) {
-    Velocity d;
-    d.head<3>() = q_b.head<3>() - q_a.head<3>();
-    d.tail<3>() = quaternion_log(orientation(q_a).conjugate() * orientation(q_b));
-    return d;
-  }
-
   static MassBlock mass_block(double mass, const Inertia& inertia) {
     MassBlock m = MassBlock::Zero();
     m.topLeftCorner<3, 3>().diagonal().setConstant(mass);

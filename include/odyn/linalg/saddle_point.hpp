@@ -151,8 +151,6 @@ class BlockSchurSaddlePoint {
     work_m_ = Eigen::VectorXd::Zero(m_);
   }
 
-  bool dense_fallback() const { return dense_fallback_; }
-
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     if (dense_fallback_) return dense_.factorize(model, ws, f);
     for (Block& block : blocks_) block.setZero();
