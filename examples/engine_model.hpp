@@ -25,22 +25,25 @@ struct Parameters {
   double clearance_volume() const { return area() * 2.0 * r / (C - 1.0); }
 };
 
-/// Otto-cycle gas force on the piston along Z. It reads the crank angle theta from the crank's
-/// rotation about X; its state keeps the cumulative angle and the half-turn the cycle is in
-/// (intake, compression, power, exhaust), which fixes the pressure law for a whole step. Its
-/// event function tells the integrator where the next half-turn starts, so that no step
-/// straddles ignition or the exhaust valve opening.
-class GasForce {
+/// Otto-cycle gas force on the piston along the cylinder axis (Z; the plane's y axis in the planar
+/// model). It reads the crank angle theta from the crank's rotation about X (the plane's normal);
+/// its state keeps the cumulative angle and the half-turn the cycle is in (intake, compression,
+/// power, exhaust), which fixes the pressure law for a whole step. Its event function tells the
+/// integrator where the next half-turn starts, so that no step straddles ignition or the exhaust
+/// valve opening.
+template <class SpaceT>
+class GasForceT {
  public:
-  using Space = odyn::Spatial;
-  static constexpr int num_bodies = 2;  // crank (for the angle), piston (where it acts)
+  using Space = SpaceT;
+  static constexpr int up = Space::dim - 1;  // index of the cylinder axis in points and forces
+  static constexpr int num_bodies = 2;       // crank (for the angle), piston (where it acts)
   using Input = odyn::ElementInput<Space, 2>;
   struct State {
     double theta = 0.0;  // cumulative crank angle at the last accepted step
     long half_turn = 0;  // the stroke is half_turn mod 4
   };
 
-  GasForce(std::string name, odyn::BodyId crank, odyn::BodyId piston, Parameters p)
+  GasForceT(std::string name, odyn::BodyId crank, odyn::BodyId piston, Parameters p)
       : name_(std::move(name)), bodies_{crank, piston}, p_(p) {}
 
   const std::string& name() const { return name_; }
@@ -72,7 +75,7 @@ class GasForce {
   void evaluate(const Input& in, const State& state, odyn::ForceBlocks<Space, 2>& out) const {
     out.force[0].setZero();
     out.force[1].setZero();
-    out.force[1][2] = force(stroke(state.half_turn), in.body(1).position.z());
+    out.force[1][up] = force(stroke(state.half_turn), in.body(1).position[up]);
   }
 
   /// The stroke (0 intake, 1 compression, 2 power, 3 exhaust) of a half-turn count.
@@ -92,14 +95,16 @@ class GasForce {
   }
 
  private:
+  /// The crank's rotation is a turn by theta in the plane of the last two axes (Y-Z in space).
   static double wrapped_angle(const Input& in) {
-    const auto& rotation = in.body(0).rotation;  // a rotation about X by theta
-    return std::atan2(rotation(2, 1), rotation(1, 1));
+    const auto& rotation = in.body(0).rotation;
+    return std::atan2(rotation(up, up - 1), rotation(up - 1, up - 1));
   }
   std::string name_;
   std::array<odyn::BodyId, 2> bodies_;
   Parameters p_;
 };
+using GasForce = GasForceT<odyn::Spatial>;
 static_assert(odyn::HasEvents<GasForce>);
 
 /// Just the element types the engine uses: nothing else is compiled or dispatched.
@@ -107,12 +112,18 @@ using Model = odyn::spatial::Model<odyn::spatial::Revolute, odyn::spatial::Spher
                                    odyn::spatial::Universal, odyn::spatial::Translational,
                                    odyn::spatial::Gravity, odyn::spatial::Rsda, GasForce>;
 
-struct Engine {
-  Model model;
+/// A built engine: its model and where its parts are.
+template <class ModelT, class BearingT, class GasT>
+struct EngineT {
+  using Model = ModelT;
+  using Space = typename ModelT::Space;
+  using Gas = GasT;
+  ModelT model;
   odyn::BodyId crank, rod, piston;
-  odyn::Handle<odyn::spatial::Revolute> bearing;
-  odyn::Handle<GasForce> gas;
+  odyn::Handle<BearingT> bearing;
+  odyn::Handle<GasT> gas;
 };
+using Engine = EngineT<Model, odyn::spatial::Revolute, GasForce>;
 
 /// Builds the engine at top dead centre; only the crank's angular velocity is given.
 inline Engine build(const Parameters& p = {}) {
@@ -148,9 +159,60 @@ inline Engine build(const Parameters& p = {}) {
   return e;
 }
 
+namespace planar {
+namespace pl = odyn::planar;
+
+using GasForce = GasForceT<odyn::Planar>;
+static_assert(odyn::HasEvents<GasForce>);
+
+/// The same engine in the Y-Z plane: 3 bodies of 3 coordinates, 4 joints of 2 equations.
+using Model = pl::Model<pl::Revolute, pl::Translational, pl::Gravity, pl::Rsda, GasForce>;
+using Engine = EngineT<Model, pl::Revolute, GasForce>;
+
+/// Builds the planar engine at top dead centre, the rod's and crank's Ixx as planar moments of
+/// inertia (plane x = global Y, plane y = global Z, phi = rotation about X).
+inline Engine build(const Parameters& p = {}) {
+  using Eigen::Vector2d;
+  Engine e;
+  pl::Body crank{.name = "crank", .mass = 1.399, .inertia = 1.524};
+  crank.angular_velocity = p.omega0;
+  pl::Body rod{.name = "rod", .mass = 0.253, .inertia = 0.399, .position = {0.0, p.r + p.L / 2.0}};
+  pl::Body piston{.name = "piston", .mass = 0.643, .inertia = 0.457, .position = {0.0, p.r + p.L}};
+  e.crank = e.model.add_body(crank);
+  e.rod = e.model.add_body(rod);
+  e.piston = e.model.add_body(piston);
+
+  e.bearing = e.model.add(pl::Revolute("bearing", odyn::ground, {}, e.crank, {}));
+  e.model.add(pl::Revolute("crank pin", e.crank, {{0.0, p.r}}, e.rod, {{0.0, -p.L / 2.0}}));
+  e.model.add(pl::Revolute("piston pin", e.rod, {{0.0, p.L / 2.0}}, e.piston, {}));
+  e.model.add(pl::Translational("cylinder", odyn::ground, {{0.0, p.r + p.L}, Vector2d::UnitY()},
+                                e.piston, {}));
+  e.model.add(pl::Gravity("gravity", {0.0, -9.81}));
+  e.model.add(pl::Rsda("load", odyn::ground, e.crank, {.damping = p.c_load}));
+  e.gas = e.model.add(GasForce("gas force", e.crank, e.piston, p));
+  return e;
+}
+}  // namespace planar
+
 /// Cumulative crank angle, from the gas force's state.
-inline double crank_angle(const Engine& e, const odyn::Workspace<Model>& ws) {
-  return std::get<Model::type_index<GasForce>>(ws.states)[e.gas.index].theta;
+template <class E>
+double crank_angle(const E& e, const odyn::Workspace<typename E::Model>& ws) {
+  using Model = typename E::Model;
+  return std::get<Model::template type_index<typename E::Gas>>(ws.states)[e.gas.index].theta;
+}
+
+/// Crank angular velocity about X, piston height and the bearing's vertical force on the crank.
+template <class E>
+double crank_rate(const E& e, const odyn::Workspace<typename E::Model>& ws) {
+  return ws.frames[e.crank.index].angular_velocity[0];
+}
+template <class E>
+double piston_height(const E& e, const odyn::Workspace<typename E::Model>& ws) {
+  return ws.frames[e.piston.index].position[E::Space::dim - 1];
+}
+template <class E>
+double bearing_force_z(const E& e, const odyn::Workspace<typename E::Model>& ws) {
+  return odyn::reaction(e.model, ws, e.bearing, odyn::Side::b).force[E::Space::dim - 1];
 }
 
 }  // namespace engine

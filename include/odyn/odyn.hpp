@@ -10,3 +10,4 @@
 #include "odyn/core/workspace.hpp"
 #include "odyn/integrators/generalized_alpha.hpp"
 #include "odyn/spatial.hpp"
+#include "odyn/planar.hpp"

@@ -58,12 +58,17 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
     if constexpr (has_events<Model>()) {
       double g_end = event_function(model, ws);
       if (g_end >= 0.0 && g_start < 0.0) {
-        // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi).
+        // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi). Trials stay a little
+        // longer than nothing: an index-3 step of a few femtoseconds turns the rounding in
+        // Phi into large velocity errors (the switch is then located to within min_trial).
+        const double min_trial = std::max(event_time_tolerance, 1e-6 * h);
         double lo = 0.0, hi = h, g_lo = g_start, g_hi = g_end;
         int stale_side = 0;
         while (hi - lo > event_time_tolerance) {
           double trial = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
           if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
+          trial = std::max(trial, min_trial);
+          if (trial >= hi) break;
           if (!integrator.attempt(trial)) integrator.fail();
           const double g = event_function(model, ws);
           if (g >= 0.0) {
@@ -76,8 +81,15 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
             stale_side = -1;
           }
         }
-        // End just past the switch, so that the element moves on to its next law.
-        if (!integrator.attempt(hi)) integrator.fail();
+        // End just past the switch, so that the element moves on to its next law. Solved
+        // again, the step may land a hair before it (Newton stops within its tolerance, on
+        // another path): then end a little later, or the next step would meet the same switch.
+        double end = hi;
+        for (int extension = 0;; ++extension) {
+          if (!integrator.attempt(end)) integrator.fail();
+          if (event_function(model, ws) >= 0.0 || extension == 10 || end >= h) break;
+          end = std::min(h, end + std::ldexp(min_trial, extension));
+        }
         integrator.commit();
         integrator.restart();
         integrator.count_event();

@@ -4,6 +4,7 @@
 // body, in global axes or in the joint frame on that body.
 
 #include <Eigen/Core>
+#include <concepts>
 
 #include "odyn/analysis/system.hpp"
 
@@ -14,9 +15,12 @@ enum class ReactionAxes { global, joint };
 /// Side of a joint: the reaction on body a (exerted by b) or on body b (exerted by a).
 enum class Side { a = 0, b = 1 };
 
+/// A joint that says where it sits on each body (side 0 = a, 1 = b) and, in global
+/// coordinates at a body frame, which axes it has there.
 template <class E>
-concept HasJointFrames = requires(const E& e) {
+concept HasJointFrames = requires(const E& e, const typename E::Space::Frame& frame) {
   e.frame(0).point;
+  { e.axes(0, frame) } -> std::convertible_to<typename E::Space::RotationMatrix>;
 };
 
 /// Reaction wrench of constraint `handle` on the body at `side`, from the workspace's last
@@ -36,14 +40,10 @@ typename Model::Space::Wrench reaction(const Model& model, const Workspace<Model
   if constexpr (HasJointFrames<E>) point = element.frame(k).point;
   const auto wrench = Space::wrench_at(frame, point, generalized);
   if (axes == ReactionAxes::global) return wrench;
-  typename Space::RotationMatrix joint_axes = frame.rotation;
-  if constexpr (HasJointFrames<E>) {
-    const auto& triad = element.frame(k);
-    joint_axes.col(0) = frame.direction(triad.u);
-    joint_axes.col(1) = frame.direction(triad.v);
-    joint_axes.col(2) = frame.direction(triad.w);
-  }
-  return Space::in_axes(wrench, joint_axes);
+  if constexpr (HasJointFrames<E>)
+    return Space::in_axes(wrench, element.axes(k, frame));
+  else
+    return Space::in_axes(wrench, frame.rotation);
 }
 
 }  // namespace odyn

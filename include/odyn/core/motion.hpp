@@ -3,8 +3,11 @@
 
 #include <cmath>
 #include <functional>
+#include <string>
 #include <utility>
 #include <vector>
+
+#include "odyn/core/errors.hpp"
 
 namespace odyn {
 
@@ -12,6 +15,13 @@ struct Motion {
   std::function<double(double)> position;      // g(t)
   std::function<double(double)> velocity;      // g'(t)
   std::function<double(double)> acceleration;  // g''(t)
+
+  /// Throws ModelError naming the driver `element` if a function is missing.
+  void require_complete(const std::string& element) const {
+    if (!position || !velocity || !acceleration)
+      throw ModelError(element,
+                       "the motion needs its position, velocity and acceleration functions");
+  }
 
   /// g(t) = start + rate t.
   static Motion constant_velocity(double rate, double start = 0.0) {

@@ -32,6 +32,7 @@ struct Spatial {
 
   /// Kinematic snapshot of one body, computed once per evaluation and read by every element.
   struct Frame {
+    using Vector = Spatial::Vector;
     Vector position = Vector::Zero();                      // centre of mass, global
     RotationMatrix rotation = RotationMatrix::Identity();  // body to global
     Vector linear_velocity = Vector::Zero();               // global

@@ -75,6 +75,12 @@ class PointTorqueT {
       : PointTorqueT(std::move(name), body, constant(torque), axes) {
     if (!torque.allFinite()) throw ModelError(name_, "torque is not finite");
   }
+  /// In the plane a torque is a number.
+  PointTorqueT(std::string name, BodyId body, double torque) requires(Space::nw == 1)
+      : PointTorqueT(std::move(name), body, Angular(Angular::Constant(torque))) {}
+  PointTorqueT(std::string name, BodyId body,
+               std::function<double(double t, const Frame&)> torque) requires(Space::nw == 1)
+      : PointTorqueT(std::move(name), body, scalar(std::move(torque))) {}
 
   const std::string& name() const { return name_; }
   const std::array<BodyId, 1>& bodies() const { return bodies_; }
@@ -90,6 +96,12 @@ class PointTorqueT {
  private:
   static Function constant(const Angular& t) {
     return [t](double, const Frame&) { return t; };
+  }
+  static Function scalar(std::function<double(double, const Frame&)> torque) {
+    if (!torque) return {};
+    return [torque = std::move(torque)](double t, const Frame& body) {
+      return Angular::Constant(torque(t, body));
+    };
   }
   std::string name_;
   std::array<BodyId, 1> bodies_;

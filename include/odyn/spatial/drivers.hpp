@@ -18,13 +18,6 @@
 
 namespace odyn::spatial {
 
-namespace detail {
-inline void check_motion(const Motion& motion, const std::string& name) {
-  if (!motion.position || !motion.velocity || !motion.acceleration)
-    throw ModelError(name, "the motion needs its position, velocity and acceleration functions");
-}
-}  // namespace detail
-
 class RevoluteDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
@@ -32,13 +25,13 @@ class RevoluteDriver : public PairJoint {
   RevoluteDriver(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
                  const JointFrame& on_b, Motion motion)
       : PairJoint(std::move(name), body_a, on_a, body_b, on_b), motion_(std::move(motion)) {
-    detail::check_motion(motion_, name_);
+    motion_.require_complete(name_);
   }
   /// Drives the angle of an existing revolute joint (same bodies and frames).
   RevoluteDriver(std::string name, const Revolute& joint, Motion motion)
       : PairJoint(joint), motion_(std::move(motion)) {
     name_ = std::move(name);
-    detail::check_motion(motion_, name_);
+    motion_.require_complete(name_);
   }
 
   void evaluate(const Input& in, BlocksOf<RevoluteDriver>& out) const {
@@ -90,7 +83,7 @@ class TranslationalDriver : public PairJoint {
   TranslationalDriver(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
                       const JointFrame& on_b, Motion motion)
       : PairJoint(std::move(name), body_a, on_a, body_b, on_b), motion_(std::move(motion)) {
-    detail::check_motion(motion_, name_);
+    motion_.require_complete(name_);
   }
   /// Drives the slide of an existing translational or cylindrical joint.
   template <class Joint>
@@ -98,7 +91,7 @@ class TranslationalDriver : public PairJoint {
   TranslationalDriver(std::string name, const Joint& joint, Motion motion)
       : PairJoint(joint), motion_(std::move(motion)) {
     name_ = std::move(name);
-    detail::check_motion(motion_, name_);
+    motion_.require_complete(name_);
   }
 
   void evaluate(const Input& in, BlocksOf<TranslationalDriver>& out) const {

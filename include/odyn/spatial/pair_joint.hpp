@@ -28,6 +28,13 @@ class PairJoint {
   const std::array<BodyId, 2>& bodies() const { return bodies_; }
   /// The joint's frame on body a (side 0) or b (side 1), in body coordinates.
   const Triad& frame(int side) const { return side == 0 ? on_a_ : on_b_; }
+  /// The joint's axes (u, v, w as columns, global) on the body at `side`, whose frame is given.
+  Space::RotationMatrix axes(int side, const Space::Frame& body) const {
+    const Triad& triad = frame(side);
+    Space::RotationMatrix columns;
+    columns << body.direction(triad.u), body.direction(triad.v), body.direction(triad.w);
+    return columns;
+  }
 
   /// Completes the reference directions from the initial pose (see JointFrame::reference).
   void bind(const Input& in) { bind_references(on_a_, on_b_, in.body(0), in.body(1)); }

@@ -1,15 +1,15 @@
 #pragma once
 // The basic constraint equations from which the spatial joints are built (Haug's catalogue,
-// written for body-frame angular velocities). Each writes rows of an element's blocks:
-//   spherical   3 rows  P_a - P_b = 0                 (points coincide)
+// written for body-frame angular velocities), beside the point constraints every space
+// shares (odyn/core/point_constraints.hpp). Each writes rows of an element's blocks:
 //   dot1        1 row   (R_a u) . (R_b w) = 0          (two body vectors stay perpendicular)
 //   dot2        1 row   (R_a u) . (P_b - P_a) = 0      (a point stays in a plane of body a)
-//   distance    1 row   (|P_b - P_a|^2 - L^2) / (2 L) = 0
 // and the matching rows of gamma, the part of Phi-ddot that does not involve accelerations,
 // with its sign changed.
 
 #include <Eigen/Core>
 
+#include "odyn/core/point_constraints.hpp"
 #include "odyn/core/spatial.hpp"
 
 namespace odyn::spatial::primitive {
@@ -17,17 +17,11 @@ namespace odyn::spatial::primitive {
 using Vec3 = Eigen::Vector3d;
 using Frame = Spatial::Frame;
 
-template <class Blocks>
-void spherical(const Frame& a, const Vec3& s_a, const Frame& b, const Vec3& s_b, Blocks& out,
-               int row) {
-  out.phi.template segment<3>(row) = a.point(s_a) - b.point(s_b);
-  out.jacobian[0].template middleRows<3>(row) = a.point_jacobian(s_a);
-  out.jacobian[1].template middleRows<3>(row) = -b.point_jacobian(s_b);
-}
-
-inline Vec3 spherical_gamma(const Frame& a, const Vec3& s_a, const Frame& b, const Vec3& s_b) {
-  return b.centripetal(s_b) - a.centripetal(s_a);
-}
+// Shared with every body space: coincident points and point distance.
+using odyn::primitive::coincident;
+using odyn::primitive::coincident_gamma;
+using odyn::primitive::distance;
+using odyn::primitive::distance_gamma;
 
 /// Gradient of (R u) . g with respect to the body-frame angular velocity: u x (R^T g).
 inline Vec3 turn_gradient(const Frame& f, const Vec3& u, const Vec3& global) {
@@ -75,22 +69,6 @@ inline double dot2_gamma(const Frame& a, const Vec3& u, const Vec3& s_a, const F
   const Vec3 d_rate = b.point_velocity(s_b) - a.point_velocity(s_a);
   return -(d.dot(a.centripetal(u)) + 2.0 * a.direction_rate(u).dot(d_rate) +
            U.dot(b.centripetal(s_b) - a.centripetal(s_a)));
-}
-
-template <class Blocks>
-void distance(const Frame& a, const Vec3& s_a, const Frame& b, const Vec3& s_b, double length,
-              Blocks& out, int row) {
-  const Vec3 d = b.point(s_b) - a.point(s_a);
-  out.phi[row] = (d.squaredNorm() - length * length) / (2.0 * length);
-  out.jacobian[0].row(row) = -d.transpose() * a.point_jacobian(s_a) / length;
-  out.jacobian[1].row(row) = d.transpose() * b.point_jacobian(s_b) / length;
-}
-
-inline double distance_gamma(const Frame& a, const Vec3& s_a, const Frame& b, const Vec3& s_b,
-                             double length) {
-  const Vec3 d = b.point(s_b) - a.point(s_a);
-  const Vec3 d_rate = b.point_velocity(s_b) - a.point_velocity(s_a);
-  return -(d_rate.squaredNorm() + d.dot(b.centripetal(s_b) - a.centripetal(s_a))) / length;
 }
 
 }  // namespace odyn::spatial::primitive

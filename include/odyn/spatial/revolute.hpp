@@ -13,7 +13,7 @@ class Revolute : public PairJoint {
 
   void evaluate(const Input& in, BlocksOf<Revolute>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
-    primitive::spherical(a, on_a_.point, b, on_b_.point, out, 0);
+    primitive::coincident(a, on_a_.point, b, on_b_.point, out, 0);
     primitive::dot1(a, on_a_.u, b, on_b_.w, out, 3);
     primitive::dot1(a, on_a_.v, b, on_b_.w, out, 4);
     out.phi_t.setZero();
@@ -22,7 +22,7 @@ class Revolute : public PairJoint {
   Eigen::Matrix<double, 5, 1> gamma(const Input& in) const {
     const auto &a = in.body(0), &b = in.body(1);
     Eigen::Matrix<double, 5, 1> g;
-    g << primitive::spherical_gamma(a, on_a_.point, b, on_b_.point),
+    g << primitive::coincident_gamma(a, on_a_.point, b, on_b_.point),
         primitive::dot1_gamma(a, on_a_.u, b, on_b_.w),
         primitive::dot1_gamma(a, on_a_.v, b, on_b_.w);
     return g;

@@ -15,12 +15,12 @@ class Spherical : public PairJoint {
       : PairJoint(std::move(name), body_a, JointFrame{point_a}, body_b, JointFrame{point_b}) {}
 
   void evaluate(const Input& in, BlocksOf<Spherical>& out) const {
-    primitive::spherical(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
+    primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
     out.phi_t.setZero();
   }
 
   Eigen::Vector3d gamma(const Input& in) const {
-    return primitive::spherical_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
+    return primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
   }
 };
 static_assert(Constraint<Spherical>);

@@ -25,7 +25,7 @@ class Universal : public PairJoint {
 
   void evaluate(const Input& in, BlocksOf<Universal>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
-    primitive::spherical(a, on_a_.point, b, on_b_.point, out, 0);
+    primitive::coincident(a, on_a_.point, b, on_b_.point, out, 0);
     primitive::dot1(a, on_a_.w, b, on_b_.w, out, 3);
     out.phi_t.setZero();
   }
@@ -33,7 +33,7 @@ class Universal : public PairJoint {
   Eigen::Vector4d gamma(const Input& in) const {
     const auto &a = in.body(0), &b = in.body(1);
     Eigen::Vector4d g;
-    g << primitive::spherical_gamma(a, on_a_.point, b, on_b_.point),
+    g << primitive::coincident_gamma(a, on_a_.point, b, on_b_.point),
         primitive::dot1_gamma(a, on_a_.w, b, on_b_.w);
     return g;
   }

@@ -1,0 +1,135 @@
+#pragma once
+// The planar body space: a rigid body moving in the x-y plane.
+//
+// Configuration of a body: position of its centre of mass and its angle phi (counter-clockwise)
+// — 3 numbers. Velocity: linear velocity of the centre of mass and the angular velocity phi' —
+// 3 numbers. Positions live on R^2 x R: the angle is an ordinary coordinate that keeps counting
+// past a full turn, so configurations integrate by plain addition, and the mass block diag(m, m, I)
+// is constant with no gyroscopic term.
+
+#include <Eigen/Core>
+#include <cmath>
+
+namespace odyn {
+
+struct Planar {
+  static constexpr int dim = 2;      // dimension of points and forces
+  static constexpr int nq = 3;       // configuration numbers per body (x, y, phi)
+  static constexpr int nv = 3;       // velocity numbers per body (x', y', phi')
+  static constexpr int linear = 0;   // offset of the linear part in a body's velocity
+  static constexpr int angular = 2;  // offset of the angular part
+  static constexpr int nw = 1;       // size of the angular part
+
+  using Vector = Eigen::Vector2d;               // a point or a free vector
+  using Angular = Eigen::Matrix<double, 1, 1>;  // an angular velocity or a torque
+  using RotationMatrix = Eigen::Matrix2d;       // body-to-global rotation
+  using Inertia = double;                       // about the centre of mass
+  using Configuration = Eigen::Matrix<double, nq, 1>;
+  using Velocity = Eigen::Matrix<double, nv, 1>;
+  using PointJacobian = Eigen::Matrix<double, dim, nv>;
+  using MassBlock = Eigen::Matrix<double, nv, nv>;
+
+  /// The vector turned by +90 degrees: d/dphi (R(phi) a) = perpendicular(R(phi) a).
+  static Vector perpendicular(const Vector& a) { return {-a.y(), a.x()}; }
+  /// z component of the cross product of two plane vectors.
+  static double cross(const Vector& a, const Vector& b) { return a.x() * b.y() - a.y() * b.x(); }
+  static RotationMatrix rotation(double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    RotationMatrix r;
+    r << c, -s, s, c;
+    return r;
+  }
+
+  /// Kinematic snapshot of one body, computed once per evaluation and read by every element.
+  struct Frame {
+    using Vector = Planar::Vector;
+    Vector position = Vector::Zero();                      // centre of mass
+    double angle = 0.0;                                    // phi, counter-clockwise
+    RotationMatrix rotation = RotationMatrix::Identity();  // body to global
+    Vector linear_velocity = Vector::Zero();
+    Angular angular_velocity = Angular::Zero();
+
+    double omega() const { return angular_velocity[0]; }
+    /// Global position of a point given in body coordinates.
+    Vector point(const Vector& local) const { return position + rotation * local; }
+    /// Global velocity of a body-fixed point.
+    Vector point_velocity(const Vector& local) const {
+      return linear_velocity + omega() * perpendicular(rotation * local);
+    }
+    /// A body-fixed direction in global coordinates.
+    Vector direction(const Vector& local) const { return rotation * local; }
+    /// Time derivative of a body-fixed direction.
+    Vector direction_rate(const Vector& local) const {
+      return omega() * perpendicular(rotation * local);
+    }
+    /// Velocity-dependent part of a body-fixed vector's second derivative: -phi'^2 R a.
+    Vector centripetal(const Vector& local) const {
+      return -omega() * omega() * (rotation * local);
+    }
+    /// d(point velocity)/d(body velocity): [I, perpendicular(R s)].
+    PointJacobian point_jacobian(const Vector& local) const {
+      PointJacobian jacobian;
+      jacobian.leftCols<2>().setIdentity();
+      jacobian.col(2) = perpendicular(rotation * local);
+      return jacobian;
+    }
+    Angular global_angular_velocity() const { return angular_velocity; }
+    /// Generalized force of a torque (in the plane, global and body torques are the same).
+    Angular torque_to_body(const Angular& torque) const { return torque; }
+  };
+
+  /// A force and a torque about the plane's normal.
+  struct Wrench {
+    Vector force = Vector::Zero();
+    Angular torque = Angular::Zero();
+  };
+
+  /// The wrench, at a body point, that a generalized force (force at the centre of mass, torque)
+  /// stands for.
+  static Wrench wrench_at(const Frame& frame, const Vector& local_point,
+                          const Velocity& generalized) {
+    Wrench wrench;
+    wrench.force = generalized.head<2>();
+    wrench.torque[0] = generalized[2] - cross(frame.rotation * local_point, wrench.force);
+    return wrench;
+  }
+
+  /// A wrench in the axes whose columns (global) are `axes`.
+  static Wrench in_axes(const Wrench& wrench, const RotationMatrix& axes) {
+    return {axes.transpose() * wrench.force, wrench.torque};
+  }
+
+  static Configuration identity() { return Configuration::Zero(); }
+
+  /// Fills a frame from a body's configuration and velocity.
+  static void make_frame(const Eigen::Ref<const Configuration>& q,
+                         const Eigen::Ref<const Velocity>& v, Frame& frame) {
+    frame.position = q.head<2>();
+    frame.angle = q[2];
+    frame.rotation = rotation(q[2]);
+    frame.linear_velocity = v.head<2>();
+    frame.angular_velocity[0] = v[2];
+  }
+
+  /// q_out = q_in + increment: the plane's motions commute, so the group is a vector space.
+  static void integrate(const Eigen::Ref<const Configuration>& q_in,
+                        const Eigen::Ref<const Velocity>& increment,
+                        Eigen::Ref<Configuration> q_out) {
+    q_out = q_in + increment;
+  }
+
+  static MassBlock mass_block(double mass, Inertia inertia) {
+    return Eigen::Vector3d(mass, mass, inertia).asDiagonal();
+  }
+
+  /// M v for one body without forming M.
+  static Velocity mass_times(double mass, Inertia inertia, const Velocity& v) {
+    return {mass * v[0], mass * v[1], inertia * v[2]};
+  }
+
+  /// A planar body has no gyroscopic force.
+  static Velocity gyroscopic_force(Inertia, const Frame&) { return Velocity::Zero(); }
+  static MassBlock gyroscopic_damping(Inertia, const Frame&) { return MassBlock::Zero(); }
+};
+
+}  // namespace odyn

@@ -1,0 +1,32 @@
+#pragma once
+// The planar element catalogue and the model types built from it. A planar model instantiates
+// only planar code: 3 coordinates per body and 2-equation pins.
+
+#include "odyn/core/model.hpp"
+#include "odyn/forces/gravity.hpp"
+#include "odyn/forces/point_load.hpp"
+#include "odyn/forces/tsda.hpp"
+#include "odyn/planar/body.hpp"
+#include "odyn/planar/distance.hpp"
+#include "odyn/planar/drivers.hpp"
+#include "odyn/planar/fixed.hpp"
+#include "odyn/planar/revolute.hpp"
+#include "odyn/planar/rsda.hpp"
+#include "odyn/planar/translational.hpp"
+
+namespace odyn::planar {
+
+using Gravity = GravityField<Planar>;
+using PointForce = PointForceT<Planar>;
+using PointTorque = PointTorqueT<Planar>;
+using Tsda = TsdaT<Planar>;
+
+/// A planar model holding just the element types a scene lists.
+template <class... Elements>
+using Model = odyn::Model<Body, Elements...>;
+
+/// Every planar element type of the library (what scripting uses).
+using DefaultModel = Model<Revolute, Translational, Fixed, Distance, RevoluteDriver,
+                           TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
+
+}  // namespace odyn::planar

@@ -1,0 +1,30 @@
+#pragma once
+// Planar fixed (weld) joint: the joint points coincide and the joint angle stays zero (the
+// axes as at the initial pose unless both are given). 3 equations.
+
+#include "odyn/planar/pair_joint.hpp"
+#include "odyn/planar/primitives.hpp"
+
+namespace odyn::planar {
+
+class Fixed : public PairJoint {
+ public:
+  static constexpr int num_equations = 3;
+  using PairJoint::PairJoint;
+
+  void evaluate(const Input& in, BlocksOf<Fixed>& out) const {
+    primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
+    out.phi[2] = angle(in);
+    angle_row(out, 2);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Vector3d gamma(const Input& in) const {
+    Eigen::Vector3d g;
+    g << primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point), 0.0;
+    return g;
+  }
+};
+static_assert(Constraint<Fixed>);
+
+}  // namespace odyn::planar

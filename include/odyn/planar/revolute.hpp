@@ -1,0 +1,26 @@
+#pragma once
+// Planar revolute (pin): the joint points coincide. 2 equations. Its angle (PairJoint::angle)
+// is what a RevoluteDriver prescribes and an Rsda resists.
+
+#include "odyn/planar/pair_joint.hpp"
+#include "odyn/planar/primitives.hpp"
+
+namespace odyn::planar {
+
+class Revolute : public PairJoint {
+ public:
+  static constexpr int num_equations = 2;
+  using PairJoint::PairJoint;
+
+  void evaluate(const Input& in, BlocksOf<Revolute>& out) const {
+    primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
+    out.phi_t.setZero();
+  }
+
+  Eigen::Vector2d gamma(const Input& in) const {
+    return primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
+  }
+};
+static_assert(Constraint<Revolute>);
+
+}  // namespace odyn::planar
