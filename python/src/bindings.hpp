@@ -1,0 +1,139 @@
+#pragma once
+// What the two translation units of odyn._core share: the model type the bindings compile
+// (every spatial element of the library, the engine's gas force and forces written in Python),
+// and the bridge that lets a Python callable act as an element's function.
+//
+// Runs release the GIL; a Python callable takes it back only for its own call.
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <odyn/odyn.hpp>
+
+#include "engine_model.hpp"  // examples/: the engine's gas force, exposed to scenes
+
+namespace odyn::python {
+
+namespace py = pybind11;
+namespace sp = odyn::spatial;
+
+/// Numbers a Python callable returned, checked for their count.
+void read_numbers(py::handle value, double* out, int count, const std::string& what);
+
+/// A body's frame as the Python callable sees it: a types.SimpleNamespace whose numpy arrays
+/// (position, rotation, linear_velocity, angular_velocity; read-only) view a buffer that is
+/// refreshed before every call. Reusing one object makes a call cost no allocation.
+class FrameView {
+ public:
+  FrameView();
+  void load(const Spatial::Frame& frame);
+  const py::object& object() const { return object_; }
+
+ private:
+  double* data_ = nullptr;  // (18) position, rotation row by row, linear, angular velocity
+  py::object object_;
+};
+
+/// A Python callable and the frame views it is handed. Calls take the GIL; the destructor too,
+/// so that an element may be dropped from any thread.
+class Callable {
+ public:
+  Callable(py::object function, int num_frames, std::string what);
+  ~Callable();
+  Callable(const Callable&) = delete;
+  Callable& operator=(const Callable&) = delete;
+
+  /// function(t, frame_0, ..., frame_{n-1}) with the frames loaded; the GIL must be held.
+  py::object call_with_frames(double t, const Spatial::Frame* const* frames);
+  /// function(a, b, c) for scalar arguments; the GIL must be held.
+  py::object call_with_numbers(std::initializer_list<double> numbers);
+  const std::string& what() const { return what_; }
+
+ private:
+  py::object function_;
+  std::vector<FrameView> views_;
+  std::string what_;  // "point force 'push'": names the element in errors
+};
+
+/// A force and torque on N bodies (global force at each centre of mass, global torque) from a
+/// Python callable: function(t, body_0, ..., body_{N-1}) -> N x 6 numbers.
+template <int N>
+class UserForceT {
+ public:
+  using Space = Spatial;
+  static constexpr int num_bodies = N;
+
+  UserForceT(std::string name, const std::array<BodyId, N>& bodies,
+             std::shared_ptr<Callable> function)
+      : name_(std::move(name)), bodies_(bodies), function_(std::move(function)) {}
+
+  const std::string& name() const { return name_; }
+  const std::array<BodyId, N>& bodies() const { return bodies_; }
+
+  void evaluate(const ElementInput<Space, N>& in, ForceBlocks<Space, N>& out) const {
+    std::array<double, 6 * N> values;
+    {
+      py::gil_scoped_acquire gil;
+      const py::object result = function_->call_with_frames(in.t, in.frames.data());
+      read_numbers(result, values.data(), 6 * N, function_->what());
+    }
+    for (int k = 0; k < N; ++k) {
+      const Eigen::Map<const Eigen::Vector3d> force(values.data() + 6 * k);
+      const Eigen::Map<const Eigen::Vector3d> torque(values.data() + 6 * k + 3);
+      out.force[k].template head<3>() = force;
+      out.force[k].template tail<3>() = in.body(k).torque_to_body(torque);
+    }
+  }
+
+ private:
+  std::string name_;
+  std::array<BodyId, N> bodies_;
+  std::shared_ptr<Callable> function_;
+};
+static_assert(StatelessForce<UserForceT<1>> && StatelessForce<UserForceT<2>>);
+
+using EngineGasForce = engine::GasForce;
+
+/// The model type of the bindings. Its element list and element_type_names below go together.
+using Model = sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal,
+                        sp::Cylindrical, sp::Fixed, sp::Distance, sp::RevoluteDriver,
+                        sp::TranslationalDriver, sp::Gravity, sp::PointForce, sp::PointTorque,
+                        sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<1>, UserForceT<2>>;
+
+inline constexpr std::array<const char*, Model::num_types> element_type_names = {
+    "revolute",
+    "translational",
+    "spherical",
+    "universal",
+    "cylindrical",
+    "fixed",
+    "distance",
+    "revolute_driver",
+    "translational_driver",
+    "gravity",
+    "point_force",
+    "point_torque",
+    "tsda",
+    "rsda",
+    "engine_gas_force",
+    "user_force",
+    "user_force"};
+
+/// The model a Python odyn.Model holds, and whether an analysis is running on it (while the
+/// GIL is released, another thread must not change it).
+struct ModelBox {
+  Model model;
+  bool running = false;
+};
+
+/// Registers the analyses (assembly, dynamics) on the module (analyses.cpp).
+void bind_analyses(py::module_& m);
+
+}  // namespace odyn::python
