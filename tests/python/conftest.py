@@ -1,8 +1,11 @@
 """Shared fixtures: paths of the repository, the engine scene and the C++ engine example."""
 
+import csv
 import pathlib
 import shutil
+import subprocess
 
+import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -24,3 +27,17 @@ def engine_binary():
     if binary is None:
         pytest.skip("the C++ engine example is not built (bash scripts/test.sh builds it)")
     return binary
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.fixture(scope="session")
+def cpp_engine(engine_binary, tmp_path_factory):
+    """The C++ example's standard run: 0..1 s, h = 1e-4, output every 1e-3 s."""
+    out = tmp_path_factory.mktemp("cpp") / "engine.csv"
+    subprocess.run([str(engine_binary), "--out", str(out)], check=True, capture_output=True)
+    return read_csv(out)

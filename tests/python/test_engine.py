@@ -1,6 +1,5 @@
 """The engine from Python (scene file, CLI, model API) equals the C++ example's output."""
 
-import csv
 import subprocess
 import sys
 
@@ -8,23 +7,9 @@ import numpy as np
 import pytest
 
 import odyn
-from conftest import ENGINE_SCENE
+from conftest import ENGINE_SCENE, read_csv
 
 COLUMNS = ["t", "theta", "omega", "z_piston", "R_z", "phi_norm", "phid_norm"]
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    return rows[0], np.array(rows[1:], dtype=float)
-
-
-@pytest.fixture(scope="module")
-def cpp_engine(engine_binary, tmp_path_factory):
-    """The C++ example's standard run: 0..1 s, h = 1e-4, output every 1e-3 s."""
-    out = tmp_path_factory.mktemp("cpp") / "engine.csv"
-    subprocess.run([str(engine_binary), "--out", str(out)], check=True, capture_output=True)
-    return read_csv(out)
 
 
 def assert_engine_equal(header, data, cpp):
