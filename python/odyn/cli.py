@@ -35,6 +35,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--plot", help="draw every output column against t into this image")
     run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
                      help="draw the scene's figures into DIR (default: .)")
+    run.add_argument("--gif", help="animate the mechanism into this GIF file")
     run.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
     check = sub.add_parser("check", help="check a scene file and describe its model")
     check.add_argument("scene")
@@ -130,6 +131,9 @@ def _run(args: argparse.Namespace) -> int:
         from .plot import scene_figures
         os.makedirs(args.figures, exist_ok=True)
         scene_figures(scene.figures, table, args.figures)
+    if args.gif:
+        from .plot import animate
+        animate(result, scene.model, args.gif, title=os.path.basename(args.scene))
     if not args.quiet:
         target = f" -> {args.out}" if args.out else ""
         print(f"odyn: {args.scene}{target}")
