@@ -10,8 +10,6 @@ examples/engine.json is the same model as a scene file (odyn run examples/engine
 import argparse
 import sys
 
-import numpy as np
-
 import odyn
 
 

@@ -8,7 +8,7 @@ floats, dicts) or raise `SceneError` naming the place (``joints[2].axis``) and w
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple
 
 from . import _core
 
@@ -23,7 +23,7 @@ class SceneError(_core.ModelError):
 REQUIRED = object()
 
 
-def fail(where: str, message: str) -> None:
+def fail(where: str, message: str) -> NoReturn:
     raise SceneError(f"{where}: {message}")
 
 
@@ -61,7 +61,7 @@ def check_vector(x: Any, where: str, size: int = 3, *, nonzero: bool = False) ->
         fail(where, f"expected a list of {size} numbers, got {_describe(x)}")
     values = [check_number(v, f"{where}[{i}]") for i, v in enumerate(x)]
     if nonzero and math.sqrt(sum(v * v for v in values)) <= 1e-12:
-        fail(where, f"zero-length vector; expected a non-zero direction")
+        fail(where, "zero-length vector; expected a non-zero direction")
     return values
 
 

@@ -6,7 +6,7 @@ import argparse
 import os
 import sys
 import time
-from typing import List, Optional
+from typing import List, NoReturn, Optional
 
 import numpy as np
 
@@ -16,7 +16,7 @@ from .scene import Scene, load, write_table
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line and exit status 1, like every bad input
+    def error(self, message: str) -> NoReturn:  # one line and exit status 1, like every bad input
         print(f"odyn: {message} (see odyn --help)", file=sys.stderr)
         sys.exit(1)
 
@@ -62,7 +62,7 @@ class _Progress:
 
     def close(self) -> None:
         if self.shown:
-            sys.stderr.write("\r" + " " * 78 + "\r")
+            sys.stderr.write("\r\033[K")
             sys.stderr.flush()
 
 
@@ -89,7 +89,7 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
         lines.append(f"  energy (kinetic + potential): {e[0]:.6g} J at t = 0, {e[-1]:.6g} J "
                      f"at the end; largest drift {result.energy_drift():.3g} J")
         final = scene.columns(result)
-        shown = [f"{k} {v[-1]:.9g}" for k, v in final.items() if k != "t"][:6]
+        shown = [f"{k} {v[-1]:.6g}" for k, v in final.items() if k != "t"][:6]
         if shown:
             lines.append("  final: " + ", ".join(shown))
     return lines

@@ -116,6 +116,21 @@ class Result:
                            + ", ".join(self._data["states"]))
         return dict(self._data["states"][element])
 
+    def save_npz(self, path: str) -> None:
+        """Every array in one .npz file: t, q, v, vdot, lambda, energies, residuals,
+        reaction/<joint> (n, side a/b, global/joint axes, force xyz + torque xyz),
+        state/<element>/<field> and bodies (their names, in the order of q and v)."""
+        arrays = {key: self._data[key] for key in (
+            "t", "q", "v", "vdot", "lambda", "kinetic_energy", "potential_energy", "phi_norm",
+            "phid_norm")}
+        arrays["bodies"] = np.array(self._bodies)
+        for name, values in self._data["reactions"].items():
+            arrays[f"reaction/{name}"] = values
+        for name, fields in self._data["states"].items():
+            for field, values in fields.items():
+                arrays[f"state/{name}/{field}"] = values
+        np.savez(path, **arrays)  # type: ignore[arg-type]
+
     def energy_drift(self) -> float:
         """Largest |E(t) - E(0)| of kinetic plus potential energy (work of dampers and
         actuators included: only a conservative model keeps it at zero)."""

@@ -25,7 +25,7 @@ from __future__ import annotations
 import csv
 import json
 import os
-from typing import Any, Dict, List, Mapping, Optional, Union
+from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Union
 
 import numpy as np
 
@@ -113,7 +113,7 @@ def _plain(params: Mapping[str, Any], where: str) -> Dict[str, Any]:
     return out
 
 
-def _check_unique(names: List[str], where: str, extra: List[str] = ()) -> None:
+def _check_unique(names: List[str], where: str, extra: Sequence[str] = ()) -> None:
     seen = set(extra)
     for i, name in enumerate(names):
         if name in seen:
@@ -123,7 +123,7 @@ def _check_unique(names: List[str], where: str, extra: List[str] = ()) -> None:
 
 def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
     d = check_keys(d, where, list(ANALYSIS_DEFAULTS) + list(ANALYSIS_OPTIONAL))
-    out = {}
+    out: Dict[str, Any] = {}
     for key, default in ANALYSIS_DEFAULTS.items():
         value = d.get(key, default)
         w = f"{where}.{key}"
@@ -231,8 +231,9 @@ def from_dict(d: Any, where: str = "") -> Scene:
     if not isinstance(bodies, list):
         fail(f"{prefix}bodies", f"expected a list of bodies, got {type(bodies).__name__}")
     for i, b in enumerate(bodies):
-        model._add_body(b if isinstance(b, Mapping) else _not_object(b, f"{prefix}bodies[{i}]"),
-                        f"{prefix}bodies[{i}]")
+        if not isinstance(b, Mapping):
+            _not_object(b, f"{prefix}bodies[{i}]")
+        model._add_body(b, f"{prefix}bodies[{i}]")
     for section, kinds in SECTIONS.items():
         entries = d.get(section, [])
         if not isinstance(entries, list):
@@ -263,8 +264,9 @@ def from_dict(d: Any, where: str = "") -> Scene:
     return Scene(model, d.get("analysis", {}), outputs, figures, description)
 
 
-def _not_object(x: Any, where: str) -> None:
+def _not_object(x: Any, where: str) -> NoReturn:
     fail(where, f"expected an object, got {json.dumps(x) if _jsonable(x) else repr(x)}")
+    raise AssertionError  # fail() raised
 
 
 def _jsonable(x: Any) -> bool:
@@ -313,10 +315,10 @@ def write_table(table: Mapping[str, np.ndarray], path: Union[str, os.PathLike]) 
     """Writes columns as CSV (12 significant digits, like the C++ example) or .npz."""
     path = os.fspath(path)
     if path.endswith(".npz"):
-        np.savez(path, **{k: np.asarray(v) for k, v in table.items()})
+        np.savez(path, **{k: np.asarray(v) for k, v in table.items()})  # type: ignore[arg-type]
         return
     names = list(table)
-    data = np.column_stack([np.asarray(table[n], dtype=float) for n in names]) if names else []
+    data: Any = np.column_stack([np.asarray(table[n], dtype=float) for n in names]) if names else []
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow(names)

@@ -4,7 +4,6 @@ import subprocess
 import sys
 
 import numpy as np
-import pytest
 
 import odyn
 from conftest import ENGINE_SCENE, read_csv
