@@ -45,7 +45,7 @@ fi
 
 # --- The Python package odyn (pip install .) -----------------------------------------------------
 # Built with the venv's scikit-build-core and pybind11 (no build isolation: no download per build)
-# in build/python/, so a rebuild compiles only what changed; skipped when the sources are those of
+# in build-python/, so a rebuild compiles only what changed; skipped when the sources are those of
 # the last install.
 if ! .venv/bin/python -c 'import scikit_build_core, pybind11' >/dev/null 2>&1; then
   echo "setup.sh: installing scikit-build-core pybind11 into .venv"

@@ -327,3 +327,26 @@ def test_python_callable_errors_reach_the_caller_with_partial_results():
     m.add_point_force(name="wrong", body="block", force=lambda t, b: (1.0, 2.0))
     with pytest.raises(TypeError, match="point_force 'wrong'.*3 numbers"):
         odyn.simulate(m, t_end=0.1)
+
+
+def test_redundant_and_unassemblable_models_name_the_joints():
+    m = odyn.Model()
+    m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
+    m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
+                   on_b=odyn.frame())
+    m.add_fixed(name="weld", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
+                on_b=odyn.frame())
+    with pytest.raises(odyn.ModelError, match=r"weld \(equation \d\): constraint equations are "
+                       "redundant"):
+        odyn.assemble(m)
+    with pytest.raises(odyn.ModelError, match="redundant") as info:
+        odyn.simulate(m, t_end=0.1)
+    assert len(info.value.result) == 0  # nothing was computed
+    m = odyn.Model()
+    m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
+    m.add_distance(name="rod 1", body_a="ground", point_a=[0, 0, 0], body_b="b",
+                   point_b=[0, 0, 0], length=1.0)
+    m.add_distance(name="rod 2", body_a="ground", point_a=[0, 0, 3], body_b="b",
+                   point_b=[0, 0, 0], length=1.0)  # the two spheres do not meet
+    with pytest.raises(odyn.AssemblyError, match="largest residual .* at joint 'rod"):
+        odyn.assemble(m)
