@@ -24,7 +24,7 @@ from .results import (BodyHistory, Interrupted, Reaction, Result, assemble,
 from .scene import Scene, load, loads, save
 
 #: Every element type that Model.add accepts (and scenes, except user_force).
-element_types = tuple(dict.fromkeys(_core.element_types))
+element_types = tuple(t for t in dict.fromkeys(_core.element_types) if t != "signal_watch")
 
 __version__ = "0.1.0"
 

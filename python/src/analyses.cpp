@@ -245,7 +245,10 @@ class Running {
     if (box.running) throw ModelError("model", "an analysis is already running on this model");
     box.running = true;
   }
-  ~Running() { box_.running = false; }
+  ~Running() {
+    box_.monitor->stop();
+    box_.running = false;
+  }
   Running(const Running&) = delete;
   Running& operator=(const Running&) = delete;
 
@@ -261,6 +264,7 @@ py::dict assemble(ModelBox& box, const py::dict& settings) {
   AssemblyReport report;
   {
     py::gil_scoped_release release;
+    box.monitor->start();
     report = odyn::assemble(box.model, ws, s);
     require_independent_constraints(box.model, ws);
     recorder.record(ws);
@@ -280,6 +284,7 @@ py::dict simulate(ModelBox& box, const py::dict& settings, py::object progress,
   std::exception_ptr error;
   {
     py::gil_scoped_release release;
+    box.monitor->start();
     using Clock = std::chrono::steady_clock;
     auto last_report = Clock::now();
     try {

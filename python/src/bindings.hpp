@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -99,13 +100,60 @@ class UserForceT {
 };
 static_assert(StatelessForce<UserForceT<1>> && StatelessForce<UserForceT<2>>);
 
+/// Lets Python see Ctrl-C inside a long output interval: while an analysis runs (the GIL
+/// released), poll() takes the GIL every 50 ms of wall time to run Python's signal handlers.
+class RunMonitor {
+ public:
+  void start() {
+    active_ = true;
+    next_check_ = std::chrono::steady_clock::now() + period;
+  }
+  void stop() { active_ = false; }
+  void poll() {
+    if (!active_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_check_) return;
+    next_check_ = now + period;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+
+ private:
+  static constexpr std::chrono::milliseconds period{50};
+  bool active_ = false;
+  std::chrono::steady_clock::time_point next_check_;
+};
+
+/// A force element on the ground that applies nothing and polls the run monitor: every model
+/// of the bindings holds one, so that each force evaluation gives Ctrl-C a chance.
+class SignalWatch {
+ public:
+  using Space = Spatial;
+  static constexpr int num_bodies = 1;
+  static inline const std::string reserved_name = "odyn: signal watch";
+
+  explicit SignalWatch(std::shared_ptr<RunMonitor> monitor) : monitor_(std::move(monitor)) {}
+  const std::string& name() const { return reserved_name; }
+  const std::array<BodyId, 1>& bodies() const { return bodies_; }
+  void evaluate(const ElementInput<Space, 1>&, ForceBlocks<Space, 1>& out) const {
+    out.force[0].setZero();
+    monitor_->poll();
+  }
+
+ private:
+  std::array<BodyId, 1> bodies_{ground};
+  std::shared_ptr<RunMonitor> monitor_;
+};
+static_assert(StatelessForce<SignalWatch>);
+
 using EngineGasForce = engine::GasForce;
 
 /// The model type of the bindings. Its element list and element_type_names below go together.
-using Model = sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal,
-                        sp::Cylindrical, sp::Fixed, sp::Distance, sp::RevoluteDriver,
-                        sp::TranslationalDriver, sp::Gravity, sp::PointForce, sp::PointTorque,
-                        sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<1>, UserForceT<2>>;
+using Model =
+    sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
+              sp::Fixed, sp::Distance, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
+              sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<1>,
+              UserForceT<2>, SignalWatch>;
 
 inline constexpr std::array<const char*, Model::num_types> element_type_names = {
     "revolute",
@@ -124,11 +172,15 @@ inline constexpr std::array<const char*, Model::num_types> element_type_names = 
     "rsda",
     "engine_gas_force",
     "user_force",
-    "user_force"};
+    "user_force",
+    "signal_watch"};
+static_assert(element_type_names.back() != nullptr, "a name for every element type");
 
 /// The model a Python odyn.Model holds, and whether an analysis is running on it (while the
 /// GIL is released, another thread must not change it).
 struct ModelBox {
+  ModelBox() { model.add(SignalWatch(monitor)); }
+  std::shared_ptr<RunMonitor> monitor = std::make_shared<RunMonitor>();
   Model model;
   bool running = false;
 };

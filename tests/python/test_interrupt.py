@@ -50,3 +50,16 @@ def test_sigint_to_the_cli_writes_the_outputs_so_far(tmp_path):
     assert rows[0] == ["t", "theta", "omega", "z_piston", "R_z", "phi_norm", "phid_norm"]
     t = np.array([float(row[0]) for row in rows[1:]])
     assert 10 < len(t) < 1_000_000 and t[-1] < 1000.0
+
+
+def test_ctrl_c_is_seen_inside_a_long_output_interval():
+    """With one output at the end, Ctrl-C still stops the run within a fraction of a second."""
+    scene = odyn.load(ENGINE_SCENE)
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(odyn.Interrupted) as info:
+        scene.simulate(t_end=1000.0, output_interval=1000.0)
+    timer.join()
+    assert time.monotonic() - start < 2.0
+    assert len(info.value.result) == 1 and info.value.result.t[0] == 0.0
