@@ -166,6 +166,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except (_core.Error, ValueError, OSError) as e:
         print(f"odyn: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # outside a run (which keeps its outputs): nothing to keep
+        print("odyn: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 import _thread
 import csv
+import os
 import signal
 import subprocess
 import sys
@@ -34,12 +35,25 @@ def test_keyboard_interrupt_in_process_keeps_partial_results():
     np.testing.assert_allclose(r.t, 1e-3 * np.arange(len(r)), atol=1e-9)
 
 
+def wait_for_cpu_seconds(pid, seconds, timeout=30.0):
+    """Waits until process `pid` has used `seconds` of CPU time (user + system)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        if (int(fields[11]) + int(fields[12])) / ticks >= seconds:
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"process {pid} did not use {seconds} s of CPU in {timeout} s")
+
+
 def test_sigint_to_the_cli_writes_the_outputs_so_far(tmp_path):
     out = tmp_path / "partial.csv"
     proc = subprocess.Popen([sys.executable, "-m", "odyn", "run", str(ENGINE_SCENE), "--t-end",
                              "1000", "--out", str(out)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    time.sleep(2.0)  # imports, then the run
+    wait_for_cpu_seconds(proc.pid, 1.5)  # imports take a few tenths: the run has begun
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=30)
     assert proc.returncode == 130, stderr
