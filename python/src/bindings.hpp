@@ -38,7 +38,10 @@ class FrameView {
   const py::object& object() const { return object_; }
 
  private:
-  double* data_ = nullptr;  // (18) position, rotation row by row, linear, angular velocity
+  // Layout of the buffer: offsets of the arrays, then its size.
+  static constexpr int position = 0, rotation = 3, linear_velocity = 12, angular_velocity = 15,
+                       size = 18;
+  double* data_ = nullptr;  // (size) owned by a capsule that the arrays keep alive
   py::object object_;
 };
 

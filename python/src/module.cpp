@@ -58,7 +58,7 @@ void read_numbers(py::handle value, double* out, int count, const std::string& w
 }
 
 FrameView::FrameView() {
-  data_ = new double[18]();
+  data_ = new double[size]();
   py::capsule owner(data_, [](void* p) { delete[] static_cast<double*>(p); });
   auto view = [&](std::vector<py::ssize_t> shape, int offset) {
     py::array_t<double> array(shape, data_ + offset, owner);
@@ -66,16 +66,17 @@ FrameView::FrameView() {
     return array;
   };
   object_ = py::module_::import("types").attr("SimpleNamespace")(
-      py::arg("position") = view({3}, 0), py::arg("rotation") = view({3, 3}, 3),
-      py::arg("linear_velocity") = view({3}, 12), py::arg("angular_velocity") = view({3}, 15));
+      py::arg("position") = view({3}, position), py::arg("rotation") = view({3, 3}, rotation),
+      py::arg("linear_velocity") = view({3}, linear_velocity),
+      py::arg("angular_velocity") = view({3}, angular_velocity));
 }
 
 void FrameView::load(const Spatial::Frame& frame) {
   for (int i = 0; i < 3; ++i) {
-    data_[i] = frame.position[i];
-    for (int j = 0; j < 3; ++j) data_[3 + 3 * i + j] = frame.rotation(i, j);
-    data_[12 + i] = frame.linear_velocity[i];
-    data_[15 + i] = frame.angular_velocity[i];
+    data_[position + i] = frame.position[i];
+    for (int j = 0; j < 3; ++j) data_[rotation + 3 * i + j] = frame.rotation(i, j);  // by rows
+    data_[linear_velocity + i] = frame.linear_velocity[i];
+    data_[angular_velocity + i] = frame.angular_velocity[i];
   }
 }
 
