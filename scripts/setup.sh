@@ -29,7 +29,7 @@ if ((${#missing[@]})); then
   apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-# --- Python virtual environment (for the coming Python bindings and their tests) -----------------
+# --- Python virtual environment (the Python bindings and their tests) -----------------------------
 # Debian's interpreter, not whatever python3 comes first on PATH: it matches python3-dev.
 python=/usr/bin/python3
 [[ -x $python ]] || python=python3
@@ -41,4 +41,22 @@ fi
 if ! .venv/bin/python -c 'import numpy, pytest, matplotlib' >/dev/null 2>&1; then
   echo "setup.sh: installing numpy pytest matplotlib into .venv"
   .venv/bin/python -m pip install -q --disable-pip-version-check numpy pytest matplotlib
+fi
+
+# --- The Python package odyn (pip install .) -----------------------------------------------------
+# Built with the venv's scikit-build-core and pybind11 (no build isolation: no download per build)
+# in build-python/, so a rebuild compiles only what changed; skipped when the sources are those of
+# the last install.
+if ! .venv/bin/python -c 'import scikit_build_core, pybind11' >/dev/null 2>&1; then
+  echo "setup.sh: installing scikit-build-core pybind11 into .venv"
+  .venv/bin/python -m pip install -q --disable-pip-version-check scikit-build-core pybind11
+fi
+stamp=.venv/odyn-sources.sha256
+sources=$(find pyproject.toml CMakeLists.txt cmake include python examples/engine_model.hpp \
+            -type f ! -name '*.pyc' -print0 | sort -z | xargs -0 sha256sum | sha256sum)
+if [[ ! -f $stamp || $(cat "$stamp") != "$sources" ]] || ! .venv/bin/python -c 'import odyn' 2>/dev/null; then
+  echo "setup.sh: pip install . (the odyn Python package)"
+  export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-build-isolation .
+  echo "$sources" > "$stamp"
 fi

@@ -1,0 +1,315 @@
+"""Checks and normalizes the parameters of bodies and elements.
+
+One description serves the Python API and scene files: each element type lists its parameters
+(named as in C++) with their kind and default. `check_*` return plain, JSON-like values (lists of
+floats, dicts) or raise `SceneError` naming the place (``joints[2].axis``) and what was expected.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple
+
+from . import _core
+
+
+class SceneError(_core.ModelError):
+    """A body, element, analysis or scene file that does not describe a valid model.
+
+    The message starts with the place, for example ``joints[2].on_a.axis: ...``.
+    """
+
+
+REQUIRED = object()
+
+
+def fail(where: str, message: str) -> NoReturn:
+    raise SceneError(f"{where}: {message}")
+
+
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) or _is_numpy_scalar(x)
+
+
+def _is_numpy_scalar(x: Any) -> bool:
+    return type(x).__module__ == "numpy" and hasattr(x, "dtype") and getattr(x, "ndim", 1) == 0
+
+
+def _describe(x: Any) -> str:
+    text = repr(x)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def check_number(x: Any, where: str, *, minimum: Optional[float] = None,
+                 positive: bool = False) -> float:
+    if not _is_number(x):
+        fail(where, f"expected a number, got {_describe(x)}")
+    value = float(x)
+    if not math.isfinite(value):
+        fail(where, f"expected a finite number, got {value}")
+    if positive and not value > 0.0:
+        fail(where, f"expected a positive number, got {value:g}")
+    if minimum is not None and value < minimum:
+        fail(where, f"expected a number >= {minimum:g}, got {value:g}")
+    return value
+
+
+def check_vector(x: Any, where: str, size: int = 3, *, nonzero: bool = False) -> List[float]:
+    if hasattr(x, "tolist"):  # numpy arrays
+        x = x.tolist()
+    if not isinstance(x, (list, tuple)) or len(x) != size:
+        fail(where, f"expected a list of {size} numbers, got {_describe(x)}")
+    values = [check_number(v, f"{where}[{i}]") for i, v in enumerate(x)]
+    if nonzero and math.sqrt(sum(v * v for v in values)) <= 1e-12:
+        fail(where, "zero-length vector; expected a non-zero direction")
+    return values
+
+
+def check_name(x: Any, where: str) -> str:
+    if not isinstance(x, str) or not x.strip():
+        fail(where, f"expected a non-empty name (a string), got {_describe(x)}")
+    return x
+
+
+def check_choice(x: Any, where: str, choices: Sequence[str]) -> str:
+    if not isinstance(x, str) or x not in choices:
+        fail(where, f"expected one of {', '.join(choices)}, got {_describe(x)}")
+    return x
+
+
+def check_callable(x: Any, where: str) -> Callable:
+    if not callable(x):
+        fail(where, f"expected a Python callable, got {_describe(x)}")
+    return x
+
+
+def check_keys(d: Any, where: str, allowed: Sequence[str], required: Sequence[str] = ()) -> Dict:
+    if not isinstance(d, Mapping):
+        fail(where, f"expected an object (a dict), got {_describe(d)}")
+    for key in d:
+        if key not in allowed:
+            fail(f"{where}.{key}" if where else str(key),
+                 f"unknown key; expected one of {', '.join(allowed)}")
+    for key in required:
+        if key not in d:
+            fail(where, f"missing '{key}'")
+    return dict(d)
+
+
+def check_frame(x: Any, where: str) -> Dict[str, Any]:
+    """A joint frame: {point, axis, reference}; point defaults to the origin, axis to z."""
+    if isinstance(x, (list, tuple)) and len(x) in (2, 3) and not _is_number(x[0]):
+        x = dict(zip(("point", "axis", "reference"), x))
+    d = check_keys(x, where, ("point", "axis", "reference"))
+    out = {
+        "point": check_vector(d.get("point", [0.0, 0.0, 0.0]), f"{where}.point"),
+        "axis": check_vector(d.get("axis", [0.0, 0.0, 1.0]), f"{where}.axis", nonzero=True),
+    }
+    if d.get("reference") is not None:
+        out["reference"] = check_vector(d["reference"], f"{where}.reference", nonzero=True)
+    return out
+
+
+MOTIONS: Dict[str, Dict[str, Any]] = {
+    "constant_velocity": {"rate": REQUIRED, "start": 0.0},
+    "polynomial": {"coefficients": REQUIRED},
+    "harmonic": {"amplitude": REQUIRED, "frequency": REQUIRED, "phase": 0.0, "offset": 0.0},
+    "function": {"position": REQUIRED, "velocity": REQUIRED, "acceleration": REQUIRED},
+}
+
+
+def check_motion(x: Any, where: str) -> Dict[str, Any]:
+    if not isinstance(x, Mapping) or "type" not in x:
+        fail(where, "expected a motion: an object with 'type' (one of "
+             + ", ".join(MOTIONS) + ") and its parameters")
+    kind = check_choice(x["type"], f"{where}.type", list(MOTIONS))
+    spec = MOTIONS[kind]
+    d = check_keys(x, where, ["type", *spec], [k for k, v in spec.items() if v is REQUIRED])
+    out: Dict[str, Any] = {"type": kind}
+    for key, default in spec.items():
+        value = d.get(key, default)
+        if kind == "function":
+            out[key] = check_callable(value, f"{where}.{key}")
+        elif key == "coefficients":
+            if hasattr(value, "tolist"):
+                value = value.tolist()
+            if not isinstance(value, (list, tuple)) or not value:
+                fail(f"{where}.{key}", f"expected a non-empty list of numbers, got "
+                     f"{_describe(value)}")
+            out[key] = [check_number(c, f"{where}.{key}[{i}]") for i, c in enumerate(value)]
+        else:
+            out[key] = check_number(value, f"{where}.{key}")
+    return out
+
+
+# --- Parameter kinds ----------------------------------------------------------------------------
+# Each kind checks one value: (value, where, model) -> normalized value. `model` resolves bodies.
+
+def _body(x, where, bodies):
+    name = check_name(x, where)
+    if name not in bodies:
+        known = ", ".join(bodies) if len(bodies) <= 12 else ", ".join(bodies[:12]) + ", ..."
+        fail(where, f"no body named '{name}'; the model has: {known}")
+    return name
+
+
+def _bodies(x, where, bodies):
+    if not isinstance(x, (list, tuple)) or len(x) not in (1, 2):
+        fail(where, f"expected a list of one or two body names, got {_describe(x)}")
+    return [_body(b, f"{where}[{i}]", bodies) for i, b in enumerate(x)]
+
+
+def _vector_or_callable(x, where, bodies):
+    return x if callable(x) else check_vector(x, where)
+
+
+def _optional_callable(x, where, bodies):
+    return None if x is None else check_callable(x, where)
+
+
+KINDS: Dict[str, Callable[[Any, str, List[str]], Any]] = {
+    "name": lambda x, w, b: check_name(x, w),
+    "body": _body,
+    "bodies": _bodies,
+    "vector": lambda x, w, b: check_vector(x, w),
+    "frame": lambda x, w, b: check_frame(x, w),
+    "number": lambda x, w, b: check_number(x, w),
+    "nonnegative": lambda x, w, b: check_number(x, w, minimum=0.0),
+    "positive": lambda x, w, b: check_number(x, w, positive=True),
+    "axes": lambda x, w, b: check_choice(x, w, ("global", "body")),
+    "motion": lambda x, w, b: check_motion(x, w),
+    "vector_or_callable": _vector_or_callable,
+    "optional_callable": _optional_callable,
+    "callable": lambda x, w, b: check_callable(x, w),
+}
+
+_PAIR = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED), "on_a": ("frame", REQUIRED),
+         "body_b": ("body", REQUIRED), "on_b": ("frame", REQUIRED)}
+_POINTS = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
+           "point_a": ("vector", [0.0, 0.0, 0.0]), "body_b": ("body", REQUIRED),
+           "point_b": ("vector", [0.0, 0.0, 0.0])}
+
+#: Every element type: parameter -> (kind, default). Names and order follow the C++ constructors.
+ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
+    "revolute": _PAIR,
+    "translational": _PAIR,
+    "spherical": _POINTS,
+    "universal": _PAIR,
+    "cylindrical": _PAIR,
+    "fixed": _PAIR,
+    "distance": {**_POINTS, "length": ("number", 0.0)},
+    "revolute_driver": {**_PAIR, "motion": ("motion", REQUIRED)},
+    "translational_driver": {**_PAIR, "motion": ("motion", REQUIRED)},
+    "gravity": {"name": ("name", REQUIRED), "acceleration": ("vector", REQUIRED)},
+    "point_force": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
+                    "point": ("vector", [0.0, 0.0, 0.0]),
+                    "force": ("vector_or_callable", REQUIRED), "axes": ("axes", "global")},
+    "point_torque": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
+                     "torque": ("vector_or_callable", REQUIRED), "axes": ("axes", "global")},
+    "tsda": {**_POINTS, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
+             "free_length": ("nonnegative", 0.0), "actuator": ("optional_callable", None)},
+    "rsda": {**_PAIR, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
+             "free_angle": ("number", 0.0), "actuator": ("optional_callable", None)},
+    # The engine's Otto-cycle gas force (shared/specs/engine.md); defaults are the spec's.
+    "engine_gas_force": {"name": ("name", REQUIRED), "crank": ("body", REQUIRED),
+                         "piston": ("body", REQUIRED), "r": ("positive", 0.04),
+                         "L": ("positive", 0.14), "D": ("positive", 0.08),
+                         "C": ("positive", 9.0), "p_atm": ("positive", 101325.0),
+                         "kappa": ("positive", 1.4), "p_comb": ("nonnegative", 3.0e6)},
+    "user_force": {"name": ("name", REQUIRED), "bodies": ("bodies", REQUIRED),
+                   "function": ("callable", REQUIRED)},
+}
+
+JOINTS = ("revolute", "translational", "spherical", "universal", "cylindrical", "fixed",
+          "distance")
+DRIVERS = ("revolute_driver", "translational_driver")
+FORCES = ("gravity", "point_force", "point_torque", "tsda", "rsda", "engine_gas_force",
+          "user_force")
+assert set(ELEMENTS) == set(JOINTS + DRIVERS + FORCES)
+
+#: Which joints a driver may name with `joint=` (it takes their bodies and frames).
+DRIVEN_JOINTS = {"revolute_driver": ("revolute",),
+                 "translational_driver": ("translational", "cylindrical")}
+
+
+def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: List[str],
+                  elements: Mapping[str, Tuple[str, Dict[str, Any]]]) -> Dict[str, Any]:
+    """Normalized parameters of an element of type `kind`; `elements`: name -> (type, params)."""
+    spec = ELEMENTS[kind]
+    params = dict(params)
+    if kind in DRIVERS and "joint" in params:
+        # Drive an existing joint: take its bodies and frames.
+        joint = check_name(params.pop("joint"), f"{where}.joint")
+        if joint not in elements or elements[joint][0] not in DRIVEN_JOINTS[kind]:
+            fail(f"{where}.joint", f"no {' or '.join(DRIVEN_JOINTS[kind])} joint named "
+                 f"'{joint}' before this driver")
+        for key in ("body_a", "on_a", "body_b", "on_b"):
+            if key in params:
+                fail(f"{where}.{key}", "give either 'joint' or the bodies and frames, not both")
+            params[key] = elements[joint][1][key]
+    check_keys(params, where, list(spec),
+               [k for k, (_, default) in spec.items() if default is REQUIRED])
+    out: Dict[str, Any] = {}
+    for key, (param_kind, default) in spec.items():
+        value = params.get(key, default)
+        out[key] = KINDS[param_kind](value, f"{where}.{key}", bodies)
+    if out["name"] in elements or out["name"] in bodies:
+        fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
+    if kind in ("spherical", "distance", "tsda") or "on_a" in spec:
+        if out["body_a"] == out["body_b"]:
+            fail(f"{where}.body_b", f"body_a and body_b are both '{out['body_a']}'; "
+                 "expected two different bodies")
+    if kind == "engine_gas_force" and out["crank"] == out["piston"]:
+        fail(f"{where}.piston", "crank and piston must be two different bodies")
+    if kind == "user_force" and len(set(out["bodies"])) != len(out["bodies"]):
+        fail(f"{where}.bodies", "the bodies must be different")
+    return out
+
+
+BODY: Dict[str, Tuple[str, Any]] = {
+    "name": ("name", REQUIRED),
+    "mass": ("positive", REQUIRED),
+    "inertia": ("inertia", REQUIRED),
+    "position": ("vector", [0.0, 0.0, 0.0]),
+    "orientation": ("quaternion", [1.0, 0.0, 0.0, 0.0]),
+    "linear_velocity": ("vector", [0.0, 0.0, 0.0]),
+    "angular_velocity": ("vector", [0.0, 0.0, 0.0]),
+    "velocity_given": ("flags", None),
+}
+
+
+def check_inertia(x: Any, where: str) -> List[List[float]]:
+    """Three principal moments, or a 3 x 3 tensor, about the centre of mass in body axes."""
+    if hasattr(x, "tolist"):
+        x = x.tolist()
+    if isinstance(x, (list, tuple)) and len(x) == 3 and all(_is_number(v) for v in x):
+        moments = check_vector(x, where)
+        return [[moments[i] if i == j else 0.0 for j in range(3)] for i in range(3)]
+    if (isinstance(x, (list, tuple)) and len(x) == 3
+            and all(isinstance(row, (list, tuple)) for row in x)):
+        return [check_vector(row, f"{where}[{i}]") for i, row in enumerate(x)]
+    fail(where, f"expected 3 principal moments or a 3 x 3 tensor, got {_describe(x)}")
+    raise AssertionError
+
+
+def check_body(params: Mapping[str, Any], where: str, names: Sequence[str]) -> Dict[str, Any]:
+    check_keys(params, where, list(BODY), [k for k, (_, d) in BODY.items() if d is REQUIRED])
+    out: Dict[str, Any] = {}
+    for key, (kind, default) in BODY.items():
+        value = params.get(key, default)
+        w = f"{where}.{key}"
+        if kind == "inertia":
+            out[key] = check_inertia(value, w)
+        elif kind == "quaternion":
+            out[key] = check_vector(value, w, 4, nonzero=True)
+        elif kind == "flags":
+            if value is not None and (not isinstance(value, (list, tuple)) or len(value) != 6
+                                      or not all(isinstance(f, bool) for f in value)):
+                fail(w, f"expected a list of 6 booleans (linear x y z, angular x y z), got "
+                     f"{_describe(value)}")
+            out[key] = None if value is None else list(value)
+        else:
+            out[key] = KINDS[kind](value, w, [])
+    if out["name"] in names or out["name"] == "ground":
+        fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
+    return out

@@ -1,0 +1,175 @@
+"""Command line: odyn run SCENE [options], odyn check SCENE (also python -m odyn)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from typing import List, NoReturn, Optional
+
+import numpy as np
+
+from . import _core
+from .results import INTEGRATORS, Interrupted, Result
+from .scene import Scene, load, write_table
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:  # one line and exit status 1, like every bad input
+        print(f"odyn: {message} (see odyn --help)", file=sys.stderr)
+        sys.exit(1)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="odyn", description="Run odyn scene files (JSON).")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    run = sub.add_parser("run", help="run a scene's dynamic analysis")
+    run.add_argument("scene", help="scene file (JSON)")
+    run.add_argument("--t-end", type=float, help="end time, s")
+    run.add_argument("--h", type=float, dest="step", help="step size, s")
+    run.add_argument("--dt-out", type=float, dest="output_interval", help="output interval, s")
+    run.add_argument("--integrator", choices=INTEGRATORS)
+    run.add_argument("--rho-inf", type=float)
+    run.add_argument("--out", help="write the output columns to a .csv or .npz file")
+    run.add_argument("--plot", help="draw every output column against t into this image")
+    run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
+                     help="draw the scene's figures into DIR (default: .)")
+    run.add_argument("--gif", help="animate the mechanism into this GIF file")
+    run.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
+    check = sub.add_parser("check", help="check a scene file and describe its model")
+    check.add_argument("scene")
+    return p
+
+
+class _Progress:
+    """A progress bar on stderr, shown only on a terminal and once a run has lasted 1 s."""
+
+    def __init__(self, t_end: float, enabled: bool) -> None:
+        self.t_end, self.enabled, self.start, self.shown = t_end, enabled, time.monotonic(), False
+
+    def __call__(self, t: float) -> None:
+        elapsed = time.monotonic() - self.start
+        if not self.enabled or elapsed < 1.0:
+            return
+        fraction = min(1.0, t / self.t_end) if self.t_end > 0 else 1.0
+        bar = "#" * int(30 * fraction)
+        eta = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        sys.stderr.write(f"\r[{bar:<30}] {100 * fraction:5.1f}%  t = {t:.4g} s  "
+                         f"elapsed {elapsed:.1f} s, left ~{eta:.1f} s ")
+        sys.stderr.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.shown:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+
+
+def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> List[str]:
+    s = result.summary or {}
+    lines = [f"{settings['integrator']} (rho_inf {settings['rho_inf']:g}), "
+             f"h = {settings['step']:g} s, t_end = {settings['t_end']:g} s: {len(result)} outputs"
+             + ("  [INTERRUPTED]" if result.interrupted else "")]
+    if s:
+        steps = s["steps"]
+        lines.append(f"  steps {steps} (events {s['events']}, rejected {s['rejected_steps']}), "
+                     f"Newton iterations {s['newton_iterations']} "
+                     f"({s['newton_iterations'] / max(steps, 1):.2f} per step), "
+                     f"factorizations {s['factorizations']}")
+        lines.append(f"  wall time {s['wall_seconds']:.3f} s "
+                     f"({1e6 * s['wall_seconds'] / max(steps, 1):.2f} us per step)")
+    else:
+        lines.append(f"  stopped at t = {result.t[-1] if len(result) else 0.0:g} s "
+                     f"after {wall:.3f} s")
+    if len(result):
+        lines.append(f"  largest residuals: |Phi| {np.max(result.phi_norm):.2e}, "
+                     f"|Phi_q v + Phi_t| {np.max(result.phid_norm):.2e}")
+        e = result.total_energy
+        lines.append(f"  energy (kinetic + potential): {e[0]:.6g} J at t = 0, {e[-1]:.6g} J "
+                     f"at the end; largest drift {result.energy_drift():.3g} J")
+        final = scene.columns(result)
+        shown = [f"{k} {v[-1]:.6g}" for k, v in final.items() if k != "t"][:6]
+        if shown:
+            lines.append("  final: " + ", ".join(shown))
+    return lines
+
+
+def _run(args: argparse.Namespace) -> int:
+    scene = load(args.scene)
+    settings = dict(scene.analysis)
+    for key in ("t_end", "step", "output_interval", "integrator", "rho_inf"):
+        value = getattr(args, key)
+        if value is not None:
+            settings[key] = value
+    if args.out and not args.out.endswith((".csv", ".npz")):
+        raise ValueError(f"--out {args.out}: expected a .csv or .npz file name")
+    progress = _Progress(settings["t_end"], not args.quiet and sys.stderr.isatty())
+    start = time.monotonic()
+    interrupted = False
+    try:
+        result = scene.simulate(progress=progress, **{k: v for k, v in settings.items()
+                                                      if k not in ("progress",)})
+    except Interrupted as stop:
+        result, interrupted = stop.result, True
+    except _core.Error as e:
+        progress.close()
+        partial = getattr(e, "result", None)
+        if partial is not None and args.out and len(partial):
+            write_table(scene.columns(partial), args.out)
+        raise
+    finally:
+        progress.close()
+    wall = time.monotonic() - start
+    table = scene.columns(result)
+    if args.out:
+        write_table(table, args.out)
+    if args.plot:
+        from .plot import all_columns
+        all_columns(table, args.plot, title=os.path.basename(args.scene))
+    if args.figures is not None:
+        from .plot import scene_figures
+        os.makedirs(args.figures, exist_ok=True)
+        scene_figures(scene.figures, table, args.figures)
+    if args.gif:
+        from .plot import animate
+        animate(result, scene.model, args.gif, title=os.path.basename(args.scene))
+    if not args.quiet:
+        target = f" -> {args.out}" if args.out else ""
+        print(f"odyn: {args.scene}{target}")
+        print("\n".join(summary_lines(scene, result, settings, wall)))
+    if interrupted:
+        print(f"odyn: interrupted; kept {len(result)} outputs up to t = "
+              f"{result.t[-1] if len(result) else 0.0:g} s", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _check(args: argparse.Namespace) -> int:
+    scene = load(args.scene)
+    m = scene.model
+    print(f"odyn: {args.scene}: valid scene")
+    print(f"  {m.num_bodies} moving bodies ({', '.join(m.body_names[1:])}), "
+          f"{len(m.element_names)} elements, {m.num_equations} constraint equations, "
+          f"{6 * m.num_bodies - m.num_equations} degrees of freedom if none is redundant")
+    a = scene.analysis
+    print(f"  analysis: {a['integrator']}, rho_inf {a['rho_inf']:g}, h {a['step']:g} s, "
+          f"t_end {a['t_end']:g} s, output every {a['output_interval']:g} s")
+    print(f"  outputs: t, {', '.join(o['name'] for o in scene.outputs)}")
+    return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return _run(args) if args.command == "run" else _check(args)
+    except (_core.Error, ValueError, OSError) as e:
+        print(f"odyn: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:  # outside a run (which keeps its outputs): nothing to keep
+        print("odyn: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

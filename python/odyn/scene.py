@@ -1,0 +1,326 @@
+"""Scene files: a whole model, its analysis settings, its output columns and figures, as JSON.
+
+    {
+      "odyn": 1,
+      "description": "...",
+      "bodies":  [{"name": "crank", "mass": 1.4, "inertia": [1.5, 1.3, 0.8], ...}],
+      "joints":  [{"type": "revolute", "name": "bearing", "body_a": "ground",
+                   "on_a": {"point": [0, 0, 0], "axis": [1, 0, 0]}, "body_b": "crank", ...}],
+      "drivers": [{"type": "revolute_driver", "name": "motor", "joint": "bearing",
+                   "motion": {"type": "constant_velocity", "rate": 10.0}}],
+      "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
+      "analysis": {"integrator": "generalized-alpha", "rho_inf": 0.9, "step": 1e-4,
+                   "t_end": 1.0, "output_interval": 1e-3},
+      "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
+                   "component": "z"}, ...],
+      "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
+    }
+
+Loading checks everything and names the place of each error (``joints[2].on_a.axis: ...``);
+unknown keys are errors. Parameters are named as in C++ (see odyn.Model's add_* methods).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _schema
+from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
+from .model import Model
+from .results import INTEGRATORS, Result, simulate
+
+FORMAT_VERSION = 1
+SECTIONS = {"joints": _schema.JOINTS, "drivers": _schema.DRIVERS,
+            "forces": tuple(t for t in _schema.FORCES if t != "user_force")}
+TOP_KEYS = ("odyn", "description", "bodies", "joints", "drivers", "forces", "analysis",
+            "outputs", "figures")
+ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf": 0.9,
+                                     "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
+ANALYSIS_OPTIONAL = ("newton_rtol", "newton_atol", "constraint_tolerance", "max_iterations")
+
+BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
+                   "linear_acceleration", "angular_acceleration")
+GLOBAL_QUANTITIES = ("phi_norm", "phid_norm", "kinetic_energy", "potential_energy",
+                     "total_energy")
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
+QUATERNION_COMPONENTS = {"w": 0, "x": 1, "y": 2, "z": 3}
+
+
+class Scene:
+    """A model with its analysis settings, output columns and figures."""
+
+    def __init__(self, model: Optional[Model] = None, analysis: Optional[Mapping] = None,
+                 outputs: Optional[List[Dict[str, Any]]] = None,
+                 figures: Optional[List[Dict[str, Any]]] = None, description: str = "") -> None:
+        self.model = model if model is not None else Model()
+        self.analysis: Dict[str, Any] = _check_analysis(dict(analysis or {}), "analysis")
+        self.outputs: List[Dict[str, Any]] = [
+            _check_output(o, f"outputs[{i}]", self.model) for i, o in enumerate(outputs or [])]
+        _check_unique([o["name"] for o in self.outputs], "outputs", extra=["t"])
+        names = ["t"] + [o["name"] for o in self.outputs]
+        self.figures: List[Dict[str, Any]] = [
+            _check_figure(f, f"figures[{i}]", names) for i, f in enumerate(figures or [])]
+        self.description = description
+
+    def simulate(self, **overrides: Any) -> Result:
+        """Runs the scene's dynamic analysis; keyword arguments override its settings."""
+        settings = {**self.analysis, **{k: v for k, v in overrides.items() if v is not None}}
+        return simulate(self.model, **settings)
+
+    def columns(self, result: Result) -> Dict[str, np.ndarray]:
+        """t and every output column of the scene, from a result."""
+        table = {"t": result.t}
+        for o in self.outputs:
+            table[o["name"]] = column(result, o)
+        return table
+
+    def to_dict(self) -> Dict[str, Any]:
+        out: Dict[str, Any] = {"odyn": FORMAT_VERSION}
+        if self.description:
+            out["description"] = self.description
+        out["bodies"] = [_plain(b, f"bodies[{i}]") for i, b in enumerate(self.model._bodies)]
+        for section, kinds in SECTIONS.items():
+            entries = []
+            for name, (kind, params, _) in self.model._elements.items():
+                if kind == "user_force" and section == "forces":
+                    fail(f"forces: '{name}'", "a user force is a Python function and cannot be "
+                         "saved in a scene file")
+                if kind in kinds:
+                    entries.append({"type": kind, **_plain(params, f"{section}: '{name}'")})
+            out[section] = entries
+        out["analysis"] = dict(self.analysis)
+        out["outputs"] = [dict(o) for o in self.outputs]
+        out["figures"] = [dict(f) for f in self.figures]
+        return out
+
+
+def _plain(params: Mapping[str, Any], where: str) -> Dict[str, Any]:
+    """Parameters as JSON values; None (an optional value left out) is dropped."""
+    out = {}
+    for key, value in params.items():
+        if value is None:
+            continue
+        if callable(value):
+            fail(f"{where}.{key}", "a Python function cannot be saved in a scene file")
+        if isinstance(value, Mapping):
+            value = _plain(value, f"{where}.{key}")
+        out[key] = value
+    return out
+
+
+def _check_unique(names: List[str], where: str, extra: Sequence[str] = ()) -> None:
+    seen = set(extra)
+    for i, name in enumerate(names):
+        if name in seen:
+            fail(f"{where}[{i}].name", f"the name '{name}' is used twice; names must be unique")
+        seen.add(name)
+
+
+def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
+    d = check_keys(d, where, list(ANALYSIS_DEFAULTS) + list(ANALYSIS_OPTIONAL))
+    out: Dict[str, Any] = {}
+    for key, default in ANALYSIS_DEFAULTS.items():
+        value = d.get(key, default)
+        w = f"{where}.{key}"
+        if key == "integrator":
+            out[key] = check_choice(value, w, INTEGRATORS)
+        elif key == "rho_inf":
+            out[key] = check_number(value, w, minimum=0.0)
+            if out[key] > 1.0:
+                fail(w, f"expected a number in [0, 1], got {out[key]:g}")
+        elif key == "t_end":
+            out[key] = check_number(value, w, minimum=0.0)
+        else:
+            out[key] = check_number(value, w, positive=True)
+    for key in ANALYSIS_OPTIONAL:
+        if key in d:
+            if key == "max_iterations":
+                if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < 1:
+                    fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
+                out[key] = d[key]
+            else:
+                out[key] = check_number(d[key], f"{where}.{key}", positive=True)
+    return out
+
+
+def _check_output(o: Any, where: str, model: Model) -> Dict[str, Any]:
+    if not isinstance(o, Mapping):
+        fail(where, f"expected an output column (an object), got {o!r}")
+    if "body" in o:
+        d = check_keys(o, where, ("name", "body", "quantity", "component"),
+                       ("name", "body", "quantity", "component"))
+        if d["body"] not in model.body_names[1:]:
+            fail(f"{where}.body", f"no moving body named {d['body']!r}")
+        check_choice(d["quantity"], f"{where}.quantity", BODY_QUANTITIES)
+        comps = QUATERNION_COMPONENTS if d["quantity"] == "orientation" else COMPONENTS
+        check_choice(d["component"], f"{where}.component", list(comps))
+    elif "reaction" in o:
+        d = check_keys(o, where, ("name", "reaction", "side", "axes", "quantity", "component"),
+                       ("name", "reaction", "quantity", "component"))
+        d.setdefault("side", "b")
+        d.setdefault("axes", "global")
+        name = d["reaction"]
+        if name not in model.element_names or (
+                model.element_type(name) not in _schema.JOINTS + _schema.DRIVERS):
+            fail(f"{where}.reaction", f"no joint or driver named {name!r}")
+        check_choice(d["side"], f"{where}.side", ("a", "b"))
+        check_choice(d["axes"], f"{where}.axes", ("global", "joint"))
+        check_choice(d["quantity"], f"{where}.quantity", ("force", "torque"))
+        check_choice(d["component"], f"{where}.component", list(COMPONENTS))
+    elif "state" in o:
+        d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
+        fields = {"rsda": ("angle",), "engine_gas_force": ("theta", "half_turn")}
+        name = d["state"]
+        if name not in model.element_names or model.element_type(name) not in fields:
+            fail(f"{where}.state", f"no stateful force (rsda, engine_gas_force) named {name!r}")
+        check_choice(d["field"], f"{where}.field", fields[model.element_type(name)])
+    else:
+        d = check_keys(o, where, ("name", "quantity"), ("name", "quantity"))
+        check_choice(d["quantity"], f"{where}.quantity", GLOBAL_QUANTITIES)
+    check_name(d["name"], f"{where}.name")
+    return d
+
+
+def _check_figure(f: Any, where: str, columns: List[str]) -> Dict[str, Any]:
+    d = check_keys(f, where, ("file", "y", "title", "ylabel", "offset", "scale"), ("file", "y"))
+    check_name(d["file"], f"{where}.file")
+    ys = d["y"] if isinstance(d["y"], list) else [d["y"]]
+    for i, y in enumerate(ys):
+        if y not in columns:
+            fail(f"{where}.y", f"no output column {y!r}; columns: {', '.join(columns)}")
+    for key in ("offset", "scale"):
+        if key in d:
+            check_number(d[key], f"{where}.{key}")
+    for key in ("title", "ylabel"):
+        if key in d and not isinstance(d[key], str):
+            fail(f"{where}.{key}", f"expected a string, got {d[key]!r}")
+    return d
+
+
+def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
+    """One output column of a result, from a scene's column description."""
+    if "body" in spec:
+        history = result.body(spec["body"])
+        values = getattr(history, spec["quantity"])
+        comps = QUATERNION_COMPONENTS if spec["quantity"] == "orientation" else COMPONENTS
+        return values[:, comps[spec["component"]]]
+    if "reaction" in spec:
+        r = result.reaction(spec["reaction"], spec.get("side", "b"), spec.get("axes", "global"))
+        return getattr(r, spec["quantity"])[:, COMPONENTS[spec["component"]]]
+    if "state" in spec:
+        return result.state(spec["state"])[spec["field"]]
+    return result[spec["quantity"]]
+
+
+# --- files --------------------------------------------------------------------------------------
+
+def from_dict(d: Any, where: str = "") -> Scene:
+    """A scene from parsed JSON; errors name the place in it."""
+    d = check_keys(d, where, TOP_KEYS, ("bodies",))
+    prefix = f"{where}." if where else ""
+    if "odyn" in d and d["odyn"] != FORMAT_VERSION:
+        fail(f"{prefix}odyn", f"unsupported scene format version {d['odyn']!r}; expected "
+             f"{FORMAT_VERSION}")
+    model = Model()
+    bodies = d["bodies"]
+    if not isinstance(bodies, list):
+        fail(f"{prefix}bodies", f"expected a list of bodies, got {type(bodies).__name__}")
+    for i, b in enumerate(bodies):
+        if not isinstance(b, Mapping):
+            _not_object(b, f"{prefix}bodies[{i}]")
+        model._add_body(b, f"{prefix}bodies[{i}]")
+    for section, kinds in SECTIONS.items():
+        entries = d.get(section, [])
+        if not isinstance(entries, list):
+            fail(f"{prefix}{section}", f"expected a list, got {type(entries).__name__}")
+        for i, e in enumerate(entries):
+            w = f"{prefix}{section}[{i}]"
+            if not isinstance(e, Mapping):
+                _not_object(e, w)
+            if "type" not in e:
+                fail(w, f"missing 'type'; expected one of {', '.join(kinds)}")
+            kind = e["type"]
+            if not isinstance(kind, str) or kind not in kinds:
+                hint = ""
+                for other, other_kinds in SECTIONS.items():
+                    if kind in other_kinds:
+                        hint = f" ('{kind}' belongs in '{other}')"
+                fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "
+                     f"{', '.join(kinds)}")
+            model._add(kind, {k: v for k, v in e.items() if k != "type"}, w)
+    description = d.get("description", "")
+    if not isinstance(description, str):
+        fail(f"{prefix}description", "expected a string")
+    outputs = d.get("outputs", [])
+    figures = d.get("figures", [])
+    for key, value in (("outputs", outputs), ("figures", figures)):
+        if not isinstance(value, list):
+            fail(f"{prefix}{key}", f"expected a list, got {type(value).__name__}")
+    return Scene(model, d.get("analysis", {}), outputs, figures, description)
+
+
+def _not_object(x: Any, where: str) -> NoReturn:
+    fail(where, f"expected an object, got {json.dumps(x) if _jsonable(x) else repr(x)}")
+    raise AssertionError  # fail() raised
+
+
+def _jsonable(x: Any) -> bool:
+    try:
+        json.dumps(x)
+        return True
+    except (TypeError, ValueError):
+        return False
+
+
+def loads(text: str, source: str = "<string>") -> Scene:
+    """A scene from JSON text."""
+    try:
+        d = json.loads(text)  # NaN and Infinity parse, and the checks name their place
+    except ValueError as e:  # json.JSONDecodeError included
+        raise SceneError(f"{source}: not valid JSON: {e}") from None
+    return from_dict(d)
+
+
+def load(path: Union[str, os.PathLike]) -> Scene:
+    """Reads and checks a scene file. Raises SceneError naming the place of any error."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise SceneError(f"{path}: cannot read: {e.strerror}") from None
+    try:
+        return loads(text, str(path))
+    except SceneError as e:
+        message = str(e)
+        if message.startswith(f"{path}:"):
+            raise
+        raise SceneError(f"{path}: {message}") from None
+
+
+def save(scene: Union[Scene, Model], path: Union[str, os.PathLike]) -> None:
+    """Writes a scene (or a model with default analysis settings) as JSON."""
+    if isinstance(scene, Model):
+        scene = Scene(scene)
+    text = json.dumps(scene.to_dict(), indent=2, allow_nan=False)
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text + "\n")
+
+
+def write_table(table: Mapping[str, np.ndarray], path: Union[str, os.PathLike]) -> None:
+    """Writes columns as CSV (12 significant digits, like the C++ example) or .npz."""
+    path = os.fspath(path)
+    if path.endswith(".npz"):
+        np.savez(path, **{k: np.asarray(v) for k, v in table.items()})  # type: ignore[arg-type]
+        return
+    names = list(table)
+    data: Any = np.column_stack([np.asarray(table[n], dtype=float) for n in names]) if names else []
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(names)
+        for row in data:
+            writer.writerow(["%.12g" % x for x in row])

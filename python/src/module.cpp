@@ -1,0 +1,340 @@
+// odyn._core: model building. Bodies and elements are added by type name with their parameters
+// in a dict whose keys are the C++ parameter names; the Python layer (python/odyn/model.py)
+// checks types and shapes first, so these functions assume well-formed values and let the
+// library's own checks (ModelError) speak for the physics.
+
+#include <Python.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "bindings.hpp"
+
+namespace odyn::python {
+
+// --- Python callables ------------------------------------------------------------------------
+
+namespace {
+bool read_flat(PyObject* value, double* out, int count, int& filled) {
+  // Fast path: tuples and lists of Python numbers (nested for several bodies).
+  if (PyFloat_Check(value) || PyLong_Check(value)) {
+    if (filled >= count) return false;
+    out[filled++] = PyFloat_AsDouble(value);
+    return !PyErr_Occurred();
+  }
+  if (PyTuple_Check(value) || PyList_Check(value)) {
+    const Py_ssize_t n = PySequence_Fast_GET_SIZE(value);
+    PyObject** items = PySequence_Fast_ITEMS(value);
+    for (Py_ssize_t i = 0; i < n; ++i)
+      if (!read_flat(items[i], out, count, filled)) return false;
+    return true;
+  }
+  // Anything else that numpy reads as numbers (arrays, numpy scalars).
+  auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!array) {
+    PyErr_Clear();
+    return false;
+  }
+  if (filled + array.size() > count) return false;
+  std::copy(array.data(), array.data() + array.size(), out + filled);
+  filled += static_cast<int>(array.size());
+  return true;
+}
+}  // namespace
+
+void read_numbers(py::handle value, double* out, int count, const std::string& what) {
+  int filled = 0;
+  if (!read_flat(value.ptr(), out, count, filled) || filled != count) {
+    if (PyErr_Occurred()) throw py::error_already_set();
+    throw py::type_error(what + ": the function must return " + std::to_string(count) +
+                         (count == 1 ? " number" : " numbers") + ", got " +
+                         std::string(py::repr(value)));
+  }
+  for (int i = 0; i < count; ++i)
+    if (!std::isfinite(out[i]))
+      throw py::value_error(what + ": the function returned a non-finite value (" +
+                            std::string(py::repr(value)) + ")");
+}
+
+FrameView::FrameView() {
+  data_ = new double[size]();
+  py::capsule owner(data_, [](void* p) { delete[] static_cast<double*>(p); });
+  auto view = [&](std::vector<py::ssize_t> shape, int offset) {
+    py::array_t<double> array(shape, data_ + offset, owner);
+    array.attr("flags").attr("writeable") = false;
+    return array;
+  };
+  object_ = py::module_::import("types").attr("SimpleNamespace")(
+      py::arg("position") = view({3}, position), py::arg("rotation") = view({3, 3}, rotation),
+      py::arg("linear_velocity") = view({3}, linear_velocity),
+      py::arg("angular_velocity") = view({3}, angular_velocity));
+}
+
+void FrameView::load(const Spatial::Frame& frame) {
+  for (int i = 0; i < 3; ++i) {
+    data_[position + i] = frame.position[i];
+    for (int j = 0; j < 3; ++j) data_[rotation + 3 * i + j] = frame.rotation(i, j);  // by rows
+    data_[linear_velocity + i] = frame.linear_velocity[i];
+    data_[angular_velocity + i] = frame.angular_velocity[i];
+  }
+}
+
+Callable::Callable(py::object function, int num_frames, std::string what)
+    : function_(std::move(function)),
+      views_(static_cast<std::size_t>(num_frames)),
+      what_(std::move(what)) {}
+
+Callable::~Callable() {
+  py::gil_scoped_acquire gil;
+  function_ = py::object();
+  views_.clear();
+}
+
+py::object Callable::call_with_frames(double t, const Spatial::Frame* const* frames) {
+  // Vectorcall with the argument slots on the stack: no tuple is built.
+  std::array<PyObject*, 4> args{};  // slot 0 is scratch (PY_VECTORCALL_ARGUMENTS_OFFSET)
+  py::object time = py::reinterpret_steal<py::object>(PyFloat_FromDouble(t));
+  args[1] = time.ptr();
+  for (std::size_t k = 0; k < views_.size(); ++k) {
+    views_[k].load(*frames[k]);
+    args[2 + k] = views_[k].object().ptr();
+  }
+  PyObject* result =
+      PyObject_Vectorcall(function_.ptr(), args.data() + 1,
+                          (1 + views_.size()) | PY_VECTORCALL_ARGUMENTS_OFFSET, nullptr);
+  if (!result) throw py::error_already_set();
+  return py::reinterpret_steal<py::object>(result);
+}
+
+py::object Callable::call_with_numbers(std::initializer_list<double> numbers) {
+  std::array<PyObject*, 4> args{};
+  std::array<py::object, 3> owned;
+  std::size_t n = 0;
+  for (const double x : numbers) {
+    owned[n] = py::reinterpret_steal<py::object>(PyFloat_FromDouble(x));
+    args[1 + n] = owned[n].ptr();
+    ++n;
+  }
+  PyObject* result = PyObject_Vectorcall(function_.ptr(), args.data() + 1,
+                                         n | PY_VECTORCALL_ARGUMENTS_OFFSET, nullptr);
+  if (!result) throw py::error_already_set();
+  return py::reinterpret_steal<py::object>(result);
+}
+
+namespace {
+
+// --- Parameters from the Python layer's dict -------------------------------------------------
+
+using Eigen::Vector3d;
+
+Vector3d vec3(const py::dict& d, const char* key) {
+  return d[key].cast<Vector3d>();
+}
+double number(const py::dict& d, const char* key) {
+  return d[key].cast<double>();
+}
+std::string text(const py::dict& d, const char* key) {
+  return d[key].cast<std::string>();
+}
+bool is_callable(const py::dict& d, const char* key) {
+  return d.contains(key) && PyCallable_Check(d[key].ptr());
+}
+std::string describe(const std::string& type, const std::string& name) {
+  return type + " '" + name + "'";
+}
+
+sp::JointFrame joint_frame(const py::dict& d, const char* key) {
+  const py::dict frame = d[key].cast<py::dict>();
+  sp::JointFrame out;
+  out.point = vec3(frame, "point");
+  out.axis = vec3(frame, "axis");
+  if (frame.contains("reference") && !frame["reference"].is_none())
+    out.reference = vec3(frame, "reference");
+  return out;
+}
+
+Axes axes(const py::dict& d) {
+  return d.contains("axes") && text(d, "axes") == "body" ? Axes::body : Axes::global;
+}
+
+/// A scalar function of one or three numbers from a Python callable.
+template <class... Args>
+std::function<double(Args...)> scalar_function(py::object f, const std::string& what) {
+  auto callable = std::make_shared<Callable>(std::move(f), 0, what);
+  return [callable](Args... args) {
+    py::gil_scoped_acquire gil;
+    double value = 0.0;
+    read_numbers(callable->call_with_numbers({static_cast<double>(args)...}), &value, 1,
+                 callable->what());
+    return value;
+  };
+}
+
+Motion motion(const py::dict& d, const std::string& what) {
+  const py::dict m = d["motion"].cast<py::dict>();
+  const std::string type = text(m, "type");
+  if (type == "constant_velocity")
+    return Motion::constant_velocity(number(m, "rate"), number(m, "start"));
+  if (type == "polynomial")
+    return Motion::polynomial(m["coefficients"].cast<std::vector<double>>());
+  if (type == "harmonic")
+    return Motion::harmonic(number(m, "amplitude"), number(m, "frequency"), number(m, "phase"),
+                            number(m, "offset"));
+  if (type == "function")
+    return {scalar_function<double>(m["position"], what + " motion position"),
+            scalar_function<double>(m["velocity"], what + " motion velocity"),
+            scalar_function<double>(m["acceleration"], what + " motion acceleration")};
+  throw ModelError(what, "unknown motion type '" + type + "'");
+}
+
+template <class Vector>
+std::function<Vector(double, const Spatial::Frame&)> frame_function(py::object f,
+                                                                    const std::string& what) {
+  auto callable = std::make_shared<Callable>(std::move(f), 1, what);
+  return [callable](double t, const Spatial::Frame& frame) {
+    const Spatial::Frame* frames[1] = {&frame};
+    Vector value;
+    py::gil_scoped_acquire gil;
+    read_numbers(callable->call_with_frames(t, frames), value.data(), 3, callable->what());
+    return value;
+  };
+}
+
+void add_element(ModelBox& box, const std::string& type, const py::dict& d) {
+  if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
+  Model& model = box.model;
+  const std::string name = text(d, "name");
+  const std::string what = describe(type, name);
+  auto body = [&](const char* key) { return model.body(text(d, key)); };
+  auto pair = [&]<class Joint>(std::type_identity<Joint>) {
+    model.add(Joint(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
+                    joint_frame(d, "on_b")));
+  };
+  if (type == "revolute") return pair(std::type_identity<sp::Revolute>{});
+  if (type == "translational") return pair(std::type_identity<sp::Translational>{});
+  if (type == "universal") return pair(std::type_identity<sp::Universal>{});
+  if (type == "cylindrical") return pair(std::type_identity<sp::Cylindrical>{});
+  if (type == "fixed") return pair(std::type_identity<sp::Fixed>{});
+  if (type == "spherical")
+    return void(model.add(sp::Spherical(name, body("body_a"), vec3(d, "point_a"), body("body_b"),
+                                        vec3(d, "point_b"))));
+  if (type == "distance")
+    return void(model.add(sp::Distance(name, body("body_a"), vec3(d, "point_a"), body("body_b"),
+                                       vec3(d, "point_b"), number(d, "length"))));
+  if (type == "revolute_driver")
+    return void(
+        model.add(sp::RevoluteDriver(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
+                                     joint_frame(d, "on_b"), motion(d, what))));
+  if (type == "translational_driver")
+    return void(model.add(sp::TranslationalDriver(name, body("body_a"), joint_frame(d, "on_a"),
+                                                  body("body_b"), joint_frame(d, "on_b"),
+                                                  motion(d, what))));
+  if (type == "gravity") return void(model.add(sp::Gravity(name, vec3(d, "acceleration"))));
+  if (type == "point_force") {
+    if (is_callable(d, "force"))
+      return void(model.add(sp::PointForce(name, body("body"), vec3(d, "point"),
+                                           frame_function<Vector3d>(d["force"], what), axes(d))));
+    return void(
+        model.add(sp::PointForce(name, body("body"), vec3(d, "point"), vec3(d, "force"), axes(d))));
+  }
+  if (type == "point_torque") {
+    if (is_callable(d, "torque"))
+      return void(model.add(sp::PointTorque(name, body("body"),
+                                            frame_function<Vector3d>(d["torque"], what), axes(d))));
+    return void(model.add(sp::PointTorque(name, body("body"), vec3(d, "torque"), axes(d))));
+  }
+  if (type == "tsda") {
+    sp::Tsda::Parameters p{
+        number(d, "stiffness"), number(d, "damping"), number(d, "free_length"), {}};
+    if (is_callable(d, "actuator"))
+      p.actuator = scalar_function<double, double, double>(d["actuator"], what + " actuator");
+    return void(model.add(
+        sp::Tsda(name, body("body_a"), vec3(d, "point_a"), body("body_b"), vec3(d, "point_b"), p)));
+  }
+  if (type == "rsda") {
+    sp::Rsda::Parameters p{
+        number(d, "stiffness"), number(d, "damping"), number(d, "free_angle"), {}};
+    if (is_callable(d, "actuator"))
+      p.actuator = scalar_function<double, double, double>(d["actuator"], what + " actuator");
+    return void(model.add(sp::Rsda(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
+                                   joint_frame(d, "on_b"), p)));
+  }
+  if (type == "engine_gas_force") {
+    engine::Parameters p;
+    p.r = number(d, "r"), p.L = number(d, "L"), p.D = number(d, "D"), p.C = number(d, "C");
+    p.p_atm = number(d, "p_atm"), p.kappa = number(d, "kappa"), p.p_comb = number(d, "p_comb");
+    return void(model.add(EngineGasForce(name, body("crank"), body("piston"), p)));
+  }
+  if (type == "user_force") {
+    const auto names = d["bodies"].cast<std::vector<std::string>>();
+    auto callable = std::make_shared<Callable>(d["function"], static_cast<int>(names.size()), what);
+    if (names.size() == 1)
+      return void(model.add(UserForceT<1>(name, {model.body(names[0])}, callable)));
+    if (names.size() == 2)
+      return void(
+          model.add(UserForceT<2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
+    throw ModelError(name, "a user force acts on one or two bodies");
+  }
+  throw ModelError(name, "unknown element type '" + type + "'");
+}
+
+void add_body(ModelBox& box, const py::dict& d) {
+  if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
+  sp::Body body;
+  body.name = text(d, "name");
+  body.mass = number(d, "mass");
+  body.inertia = d["inertia"].cast<Eigen::Matrix3d>();
+  body.position = vec3(d, "position");
+  const Eigen::Vector4d q = d["orientation"].cast<Eigen::Vector4d>();  // w, x, y, z
+  body.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  body.linear_velocity = vec3(d, "linear_velocity");
+  body.angular_velocity = vec3(d, "angular_velocity");
+  if (d.contains("velocity_given") && !d["velocity_given"].is_none())
+    body.velocity_given = d["velocity_given"].cast<std::array<bool, 6>>();
+  box.model.add_body(std::move(body));
+}
+
+}  // namespace
+
+}  // namespace odyn::python
+
+PYBIND11_MODULE(_core, m) {
+  using namespace odyn::python;
+  m.doc() = "odyn's compiled core: model building and analyses (use the odyn package instead)";
+
+  static py::exception<odyn::Error> error(m, "Error", PyExc_RuntimeError);
+  static py::exception<odyn::ModelError> model_error(m, "ModelError", error.ptr());
+  static py::exception<odyn::AssemblyError> assembly_error(m, "AssemblyError", error.ptr());
+  static py::exception<odyn::SolverError> solver_error(m, "SolverError", error.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const odyn::ModelError& e) {
+      py::set_error(model_error, e.what());
+    } catch (const odyn::AssemblyError& e) {
+      py::set_error(assembly_error, e.what());
+    } catch (const odyn::SolverError& e) {
+      py::set_error(solver_error, e.what());
+    } catch (const odyn::Error& e) {
+      py::set_error(error, e.what());
+    }
+  });
+
+  py::class_<ModelBox>(m, "Model", "The C++ model (odyn.Model wraps it).")
+      .def(py::init<>())
+      .def("add_body", &add_body, py::arg("parameters"))
+      .def("add_element", &add_element, py::arg("type"), py::arg("parameters"))
+      .def_property_readonly("num_bodies", [](const ModelBox& b) { return b.model.num_bodies(); })
+      .def_property_readonly("num_equations",
+                             [](const ModelBox& b) { return b.model.num_equations(); })
+      .def("body_index",
+           [](const ModelBox& b, const std::string& name) { return b.model.body(name).index; })
+      .def("element_type", [](const ModelBox& b, const std::string& name) {
+        return std::string(element_type_names[b.model.locate(name).type]);
+      });
+
+  m.attr("element_types") =
+      py::cast(std::vector<std::string>(element_type_names.begin(), element_type_names.end()));
+  bind_analyses(m);
+}

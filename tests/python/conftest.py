@@ -1,0 +1,43 @@
+"""Shared fixtures: paths of the repository, the engine scene and the C++ engine example."""
+
+import csv
+import pathlib
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+ENGINE_SCENE = ROOT / "examples" / "engine.json"
+
+
+def find_engine_binary():
+    """The C++ engine example built by scripts/test.sh (build/examples/engine), if any."""
+    for candidate in (ROOT / "build" / "examples" / "engine",):
+        if candidate.is_file():
+            return candidate
+    found = shutil.which("engine")
+    return pathlib.Path(found) if found else None
+
+
+@pytest.fixture(scope="session")
+def engine_binary():
+    binary = find_engine_binary()
+    if binary is None:
+        pytest.skip("the C++ engine example is not built (bash scripts/test.sh builds it)")
+    return binary
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.fixture(scope="session")
+def cpp_engine(engine_binary, tmp_path_factory):
+    """The C++ example's standard run: 0..1 s, h = 1e-4, output every 1e-3 s."""
+    out = tmp_path_factory.mktemp("cpp") / "engine.csv"
+    subprocess.run([str(engine_binary), "--out", str(out)], check=True, capture_output=True)
+    return read_csv(out)

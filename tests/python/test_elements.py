@@ -1,0 +1,352 @@
+"""Every element type reachable from Python, each checked against a hand-computed or analytic
+value; Python callables checked against the same force computed in C++."""
+
+import math
+
+import numpy as np
+import pytest
+
+import odyn
+
+G = 9.81
+X, Y, Z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
+TESTED = set()
+
+
+def covers(*types):
+    TESTED.update(types)
+
+
+def pendulum(joint="revolute"):
+    """A 1 kg bob (inertia 1e-3) at (1, 0, 0) hinged at the origin about Z; gravity -Y."""
+    m = odyn.Model()
+    m.add_body(name="bob", mass=1.0, inertia=[1e-3, 1e-3, 1e-3], position=[1, 0, 0])
+    if joint == "revolute":
+        m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 0], Z),
+                       body_b="bob", on_b=odyn.frame([-1, 0, 0], Z))
+    else:
+        m.add_spherical(name="hinge", body_a="ground", point_a=[0, 0, 0], body_b="bob",
+                        point_b=[-1, 0, 0])
+    m.add_gravity(name="gravity", acceleration=[0, -G, 0])
+    return m
+
+
+@pytest.mark.parametrize("joint", ["revolute", "spherical"])
+def test_pendulum_released_horizontal(joint):
+    covers(joint, "gravity")
+    a = odyn.assemble(pendulum(joint))
+    alpha = -G * 1.0 / (1e-3 + 1.0)  # m g L / (J + m L^2)
+    np.testing.assert_allclose(a.vdot[0], [0, alpha, 0, 0, 0, alpha], atol=1e-12)
+    # Hinge force on the bob: m a - m g (global axes).
+    np.testing.assert_allclose(a.reaction("hinge").force[0], [0, alpha + G, 0], atol=1e-12)
+    np.testing.assert_allclose(a.reaction("hinge", side="a").force[0], [0, -(alpha + G), 0],
+                               atol=1e-12)
+    r = odyn.simulate(pendulum(joint), t_end=2.0, step=1e-3, output_interval=0.01)
+    assert r.energy_drift() < 2e-3 * G  # mildly dissipative generalized-alpha
+    np.testing.assert_allclose(np.linalg.norm(r.body("bob").position, axis=1), 1.0, atol=1e-10)
+
+
+def slider(kind, axis, spin=0.0):
+    m = odyn.Model()
+    m.add_body(name="block", mass=2.0, inertia=[0.1, 0.1, 0.1], angular_velocity=[
+        spin * a / np.linalg.norm(axis) for a in axis])
+    getattr(m, f"add_{kind}")(name="guide", body_a="ground", on_a=odyn.frame([0, 0, 0], axis),
+                              body_b="block", on_b=odyn.frame([0, 0, 0], axis))
+    m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+    return m
+
+
+@pytest.mark.parametrize("kind", ["translational", "cylindrical"])
+def test_block_slides_down_a_45_degree_guide(kind):
+    covers(kind)
+    axis = [1, 0, -1]
+    r = odyn.simulate(slider(kind, axis, spin=3.0 if kind == "cylindrical" else 0.0),
+                      t_end=1.0, step=1e-3, output_interval=0.5)
+    # Acceleration g sin 45 along the guide: s = g t^2 / (2 sqrt 2).
+    s = G * r.t**2 / (2 * math.sqrt(2))
+    expected = np.column_stack([s / math.sqrt(2), 0 * s, -s / math.sqrt(2)])
+    np.testing.assert_allclose(r.body("block").position, expected, atol=1e-9)
+    # The guide pushes perpendicular to itself: m g cos 45 along (1, 0, 1)/sqrt 2.
+    np.testing.assert_allclose(r.reaction("guide").force[-1], [G, 0, G], atol=1e-8)
+    if kind == "cylindrical":  # free to spin about the guide: the spin stays
+        w = r.body("block").angular_velocity[-1]
+        np.testing.assert_allclose(w, 3.0 * np.array(axis) / math.sqrt(2), atol=1e-9)
+
+
+def test_fixed_and_universal_hold_a_body_at_rest():
+    covers("fixed", "universal")
+    for kind in ("fixed", "universal"):
+        m = odyn.Model()
+        m.add_body(name="b", mass=3.0, inertia=[0.2, 0.3, 0.4], position=[0, 0, -1])
+        if kind == "fixed":
+            m.add_fixed(name="j", body_a="ground", on_a=odyn.frame([0, 0, 0], Z), body_b="b",
+                        on_b=odyn.frame([0, 0, 1], Z))
+        else:
+            m.add_universal(name="j", body_a="ground", on_a=odyn.frame([0, 0, 0], X),
+                            body_b="b", on_b=odyn.frame([0, 0, 1], Y))
+        m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+        r = odyn.simulate(m, t_end=0.5, step=1e-3, output_interval=0.25)
+        np.testing.assert_allclose(r.body("b").position[-1], [0, 0, -1], atol=1e-10)
+        np.testing.assert_allclose(r.reaction("j").force, np.tile([0, 0, 3.0 * G], (3, 1)),
+                                   atol=1e-8)
+        # In the joint frame on b the axis is w: a fixed joint carries m g along it.
+        if kind == "fixed":
+            np.testing.assert_allclose(r.reaction("j", axes="joint").force[-1, 2], 3.0 * G,
+                                       atol=1e-8)
+
+
+def test_distance_lets_a_horizontal_bob_fall_freely_at_first():
+    covers("distance")
+    m = odyn.Model()
+    m.add_body(name="bob", mass=1.0, inertia=[1e-3] * 3, position=[1, 0, 0])
+    m.add_distance(name="rod", body_a="ground", point_a=[0, 0, 0], body_b="bob",
+                   point_b=[0, 0, 0])
+    m.add_gravity(name="gravity", acceleration=[0, -G, 0])
+    a = odyn.assemble(m)
+    np.testing.assert_allclose(a.vdot[0, :3], [0, -G, 0], atol=1e-12)
+    np.testing.assert_allclose(a.multipliers("rod"), [[0.0]], atol=1e-12)
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.1)
+    np.testing.assert_allclose(np.linalg.norm(r.body("bob").position, axis=1), 1.0, atol=1e-10)
+
+
+def driven_pendulum(motion):
+    m = pendulum()
+    m.add_revolute_driver(name="motor", joint="hinge", motion=motion)
+    return m
+
+
+def test_revolute_driver_turns_the_bob_at_the_given_rate():
+    covers("revolute_driver")
+    r = odyn.simulate(driven_pendulum(odyn.constant_velocity(2.0)), t_end=1.0, step=1e-3,
+                      output_interval=0.1)
+    angle = 2.0 * r.t
+    np.testing.assert_allclose(r.body("bob").position[:, :2],
+                               np.column_stack([np.cos(angle), np.sin(angle)]), atol=1e-9)
+    # At constant rate the motor's torque balances gravity's, -m g L cos(angle) (within the
+    # index-3 integrator's start-up transient in lambda).
+    torque = r.reaction("motor").torque[:, 2]
+    np.testing.assert_allclose(torque, G * np.cos(angle), atol=2e-4)
+    # The same motion from Python functions gives the same run.
+    py = odyn.simulate(driven_pendulum(odyn.motion_function(
+        lambda t: 2.0 * t, lambda t: 2.0, lambda t: 0.0)), t_end=1.0, step=1e-3,
+        output_interval=0.1)
+    np.testing.assert_allclose(py.q, r.q, atol=1e-12)
+
+
+def test_translational_driver_follows_a_harmonic_motion():
+    covers("translational_driver")
+    m = odyn.Model()
+    m.add_body(name="slide", mass=1.0, inertia=[0.1] * 3)
+    m.add_translational(name="guide", body_a="ground", on_a=odyn.frame([0, 0, 0], X),
+                        body_b="slide", on_b=odyn.frame([0, 0, 0], X))
+    m.add_translational_driver(name="drive", joint="guide",
+                               motion=odyn.harmonic(0.1, 3.0))
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.05)
+    np.testing.assert_allclose(r.body("slide").position[:, 0], 0.1 * np.sin(3.0 * r.t),
+                               atol=1e-10)
+    # The drive's force is m x'' = -0.9 sin(3 t) along X (after the index-3 integrator's
+    # start-up transient in lambda, which has died out by the fourth output).
+    force = r.reaction("drive").force[:, 0]
+    np.testing.assert_allclose(force, -0.9 * np.sin(3.0 * r.t), atol=2e-3)
+    np.testing.assert_allclose(force[3:], -0.9 * np.sin(3.0 * r.t[3:]), atol=1e-5)
+    poly = odyn.Model()
+    poly.add_body(name="slide", mass=1.0, inertia=[0.1] * 3)
+    poly.add_translational_driver(name="drive", body_a="ground", on_a=odyn.frame([0, 0, 0], X),
+                                  body_b="slide", on_b=odyn.frame([0, 0, 0], X),
+                                  motion=odyn.polynomial([0.0, 0.5, 0.25]))
+    a = odyn.assemble(poly)
+    # Only the drive constrains: x' = 0.5, x'' = 0.5 (other components free, unforced).
+    np.testing.assert_allclose(a.v[0, 0], 0.5, atol=1e-12)
+    np.testing.assert_allclose(a.vdot[0, 0], 0.5, atol=1e-12)
+
+
+def free_body(**kw):
+    m = odyn.Model()
+    m.add_body(name="b", mass=0.5, inertia=[0.1, 0.1, 0.2], **kw)
+    return m
+
+
+def test_free_fall():
+    m = free_body(position=[0, 0, 10])
+    m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.25)
+    np.testing.assert_allclose(r.body("b").position[:, 2], 10 - G * r.t**2 / 2, atol=1e-9)
+    np.testing.assert_allclose(r.total_energy, r.total_energy[0], atol=1e-8)
+
+
+def test_point_force_and_torque_constant_in_global_and_body_axes():
+    covers("point_force", "point_torque")
+    m = free_body()
+    m.add_point_force(name="push", body="b", force=[2, 0, 0])
+    m.add_point_torque(name="twist", body="b", torque=[0, 0, 0.4])
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.5)
+    np.testing.assert_allclose(r.body("b").position[:, 0], 2 * r.t**2, atol=1e-9)
+    np.testing.assert_allclose(r.body("b").angular_velocity[:, 2], 2 * r.t, atol=1e-9)
+    # Body turned 90 degrees about Z: body X is global Y.
+    q = [math.cos(math.pi / 4), 0, 0, math.sin(math.pi / 4)]
+    m = free_body(orientation=q)
+    m.add_point_force(name="push", body="b", force=[2, 0, 0], axes="body")
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.5)
+    np.testing.assert_allclose(r.body("b").position[:, :2],
+                               np.column_stack([0 * r.t, 2 * r.t**2]), atol=1e-9)
+
+
+def spring_on_rail(kind, k=100.0, c=0.0):
+    """A 1 kg block on a rail along X, pulled towards x = 1 by a spring (k, c)."""
+    m = odyn.Model()
+    m.add_body(name="block", mass=1.0, inertia=[0.1] * 3, position=[1.2, 0, 0])
+    m.add_translational(name="rail", body_a="ground", on_a=odyn.frame([0, 0, 0], X),
+                        body_b="block", on_b=odyn.frame([0, 0, 0], X))
+    if kind == "tsda":
+        m.add_tsda(name="spring", body_a="ground", point_a=[0, 0, 0], body_b="block",
+                   point_b=[0, 0, 0], stiffness=k, damping=c, free_length=1.0)
+    elif kind == "point_force":
+        m.add_point_force(name="spring", body="block", force=lambda t, b: (
+            -k * (b.position[0] - 1.0) - c * b.linear_velocity[0], 0.0, 0.0))
+    elif kind == "user_force":
+        m.add_user_force(name="spring", bodies=["block"], function=lambda t, b: (
+            -k * (b.position[0] - 1.0) - c * b.linear_velocity[0], 0, 0, 0, 0, 0))
+    return m
+
+
+def test_tsda_oscillates_at_the_natural_frequency():
+    covers("tsda")
+    r = odyn.simulate(spring_on_rail("tsda"), t_end=1.0, step=1e-4, output_interval=0.01)
+    np.testing.assert_allclose(r.body("block").position[:, 0], 1 + 0.2 * np.cos(10 * r.t),
+                               atol=2e-5)
+    np.testing.assert_allclose(r.potential_energy, 0.5 * 100 * (0.2 * np.cos(10 * r.t))**2,
+                               atol=2e-3)
+
+
+def test_tsda_actuator_from_python_shifts_the_equilibrium():
+    m = odyn.Model()
+    m.add_body(name="block", mass=1.0, inertia=[0.1] * 3, position=[1.2, 0, 0])
+    m.add_translational(name="rail", body_a="ground", on_a=odyn.frame([0, 0, 0], X),
+                        body_b="block", on_b=odyn.frame([0, 0, 0], X))
+    m.add_tsda(name="spring", body_a="ground", point_a=[0, 0, 0], body_b="block",
+               point_b=[0, 0, 0], stiffness=100.0, free_length=1.0,
+               actuator=lambda t, length, rate: 10.0)  # 10 N more tension: x_eq = 0.9
+    r = odyn.simulate(m, t_end=1.0, step=1e-4, output_interval=0.01)
+    np.testing.assert_allclose(r.body("block").position[:, 0], 0.9 + 0.3 * np.cos(10 * r.t),
+                               atol=3e-5)
+
+
+@pytest.mark.parametrize("kind", ["point_force", "user_force"])
+def test_python_spring_damper_matches_the_cpp_tsda(kind):
+    covers("user_force")
+    ref = odyn.simulate(spring_on_rail("tsda", c=2.0), t_end=1.0, step=1e-4, output_interval=0.01)
+    py = odyn.simulate(spring_on_rail(kind, c=2.0), t_end=1.0, step=1e-4, output_interval=0.01)
+    # Same force, same steps; the C++ element also gives Newton its stiffness, so the
+    # iterates differ within Newton's tolerance only.
+    np.testing.assert_allclose(py.q, ref.q, atol=1e-9)
+    np.testing.assert_allclose(py.v, ref.v, atol=1e-7)
+
+
+def test_two_body_user_force_matches_the_cpp_tsda():
+    def model(python):
+        m = odyn.Model()
+        m.add_body(name="a", mass=1.0, inertia=[0.1] * 3, position=[-0.6, 0, 0])
+        m.add_body(name="b", mass=2.0, inertia=[0.1] * 3, position=[0.6, 0, 0],
+                   linear_velocity=[0, 0.5, 0])
+        if python:
+            def spring(t, a, b):
+                d = np.asarray(b.position) - np.asarray(a.position)
+                length = np.linalg.norm(d)
+                f = 50.0 * (length - 1.0) * d / length  # pulls a towards b
+                return [[*f, 0, 0, 0], [*(-f), 0, 0, 0]]
+            m.add_user_force(name="spring", bodies=["a", "b"], function=spring)
+        else:
+            m.add_tsda(name="spring", body_a="a", point_a=[0, 0, 0], body_b="b",
+                       point_b=[0, 0, 0], stiffness=50.0, free_length=1.0)
+        return m
+    ref = odyn.simulate(model(False), t_end=1.0, step=1e-3, output_interval=0.05)
+    py = odyn.simulate(model(True), t_end=1.0, step=1e-3, output_interval=0.05)
+    np.testing.assert_allclose(py.q, ref.q, atol=1e-9)
+    # Momentum is conserved: the centre of mass moves at (0, 1/3, 0).
+    com = (py.body("a").position + 2 * py.body("b").position) / 3
+    np.testing.assert_allclose(com[:, 1], r_t := py.t / 3, atol=1e-9)
+    assert r_t[-1] > 0
+
+
+def rotor(kind, k=4.0, c=0.0, actuator=None):
+    m = odyn.Model()
+    m.add_body(name="rotor", mass=1.0, inertia=[0.5, 0.5, 1.0], angular_velocity=[0, 0, 1.0])
+    m.add_revolute(name="axle", body_a="ground", on_a=odyn.frame([0, 0, 0], Z), body_b="rotor",
+                   on_b=odyn.frame([0, 0, 0], Z))
+    if kind == "rsda":
+        m.add_rsda(name="spring", body_a="ground", on_a=odyn.frame([0, 0, 0], Z), body_b="rotor",
+                   on_b=odyn.frame([0, 0, 0], Z), stiffness=k, damping=c, actuator=actuator)
+    else:  # the damper as a Python torque
+        m.add_point_torque(name="spring", body="rotor",
+                           torque=lambda t, b: (0.0, 0.0, -c * b.angular_velocity[2]))
+    return m
+
+
+def test_rsda_twists_harmonically_and_counts_the_angle():
+    covers("rsda")
+    r = odyn.simulate(rotor("rsda"), t_end=2.0, step=1e-4, output_interval=0.01)
+    np.testing.assert_allclose(r.state("spring")["angle"], 0.5 * np.sin(2 * r.t), atol=2e-5)
+    r = odyn.simulate(rotor("rsda", actuator=lambda t, angle, rate: 2.0), t_end=2.0, step=1e-4,
+                      output_interval=0.01)
+    expected = 0.5 * (1 - np.cos(2 * r.t)) + 0.5 * np.sin(2 * r.t)
+    np.testing.assert_allclose(r.state("spring")["angle"], expected, atol=2e-5)
+
+
+def test_python_damping_torque_matches_the_cpp_rsda():
+    ref = odyn.simulate(rotor("rsda", k=0.0, c=0.3), t_end=1.0, step=1e-4, output_interval=0.01)
+    py = odyn.simulate(rotor("torque", c=0.3), t_end=1.0, step=1e-4, output_interval=0.01)
+    np.testing.assert_allclose(py.v, ref.v, atol=1e-9)
+    # omega = exp(-c t / J)
+    np.testing.assert_allclose(py.body("rotor").angular_velocity[:, 2], np.exp(-0.3 * py.t),
+                               atol=1e-6)
+
+
+def test_engine_gas_force_is_covered_by_the_engine_tests():
+    covers("engine_gas_force")  # tests/python/test_engine.py checks it against the C++ example
+
+
+def test_every_element_type_is_tested():
+    # Runs last in this file (pytest keeps file order).
+    assert set(odyn.element_types) == TESTED
+
+
+def test_python_callable_errors_reach_the_caller_with_partial_results():
+    m = spring_on_rail("tsda")
+
+    def bad(t, b):
+        if t > 0.05:
+            raise ZeroDivisionError("boom")
+        return (0.0, 0.0, 0.0)
+    m.add_point_force(name="bad", body="block", force=bad)
+    with pytest.raises(ZeroDivisionError, match="boom") as info:
+        odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.01)
+    partial = info.value.result
+    assert partial.interrupted and 5 <= len(partial) <= 7
+
+    m = spring_on_rail("tsda")
+    m.add_point_force(name="wrong", body="block", force=lambda t, b: (1.0, 2.0))
+    with pytest.raises(TypeError, match="point_force 'wrong'.*3 numbers"):
+        odyn.simulate(m, t_end=0.1)
+
+
+def test_redundant_and_unassemblable_models_name_the_joints():
+    m = odyn.Model()
+    m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
+    m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
+                   on_b=odyn.frame())
+    m.add_fixed(name="weld", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
+                on_b=odyn.frame())
+    with pytest.raises(odyn.ModelError, match=r"weld \(equation \d\): constraint equations are "
+                       "redundant"):
+        odyn.assemble(m)
+    with pytest.raises(odyn.ModelError, match="redundant") as info:
+        odyn.simulate(m, t_end=0.1)
+    assert len(info.value.result) == 0  # nothing was computed
+    m = odyn.Model()
+    m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
+    m.add_distance(name="rod 1", body_a="ground", point_a=[0, 0, 0], body_b="b",
+                   point_b=[0, 0, 0], length=1.0)
+    m.add_distance(name="rod 2", body_a="ground", point_a=[0, 0, 3], body_b="b",
+                   point_b=[0, 0, 0], length=1.0)  # the two spheres do not meet
+    with pytest.raises(odyn.AssemblyError, match="largest residual .* at joint 'rod"):
+        odyn.assemble(m)
