@@ -3,6 +3,7 @@
 // `slider_crank_planar`): options, the CSV of the paper's outputs and the summary.
 //
 //   NAME [--h STEP] [--t-end T] [--dt-out DT] [--out FILE] [--integrator NAME] [--rho-inf R]
+//        [--rtol R] [--atol A]
 
 #include <cstdio>
 #include <cstdlib>
@@ -35,8 +36,10 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
   const auto usage = [&] {
     std::cerr << "usage: " << program
               << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
-                 "       [--integrator generalized-alpha|hht] [--rho-inf R]\n";
+                 "       [--integrator generalized-alpha|hht|dopri5] [--rho-inf R]\n"
+                 "       [--rtol R] [--atol A]   (error control: --h is then the first step)\n";
   };
+  bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
     if (option == "--help" || option == "-h") {
@@ -60,12 +63,17 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
       settings.integrator = value;
     else if (option == "--rho-inf")
       settings.generalized_alpha.rho_inf = cli::number(program, "--rho-inf", value);
+    else if (option == "--rtol")
+      settings.rtol = cli::number(program, "--rtol", value), tolerance_given = true;
+    else if (option == "--atol")
+      settings.atol = cli::number(program, "--atol", value), tolerance_given = true;
     else {
       std::cerr << program << ": unknown option " << option << "\n";
       usage();
       return 1;
     }
   }
+  settings.generalized_alpha.adaptive = tolerance_given;
 
   try {
     auto e = build();

@@ -6,20 +6,34 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/generalized_alpha.hpp"
+#include "odyn/integrators/integrator.hpp"
 
 namespace odyn {
 
 struct DynamicsSettings {
-  double step = 1e-4;             // h, s (rounded down so that steps land on output times)
+  /// s: the step of a fixed-step run (shortened so that steps land on output times), or the
+  /// first step of a run with error control.
+  double step = 1e-4;
   double t_end = 1.0;             // s
   double output_interval = 1e-3;  // s
-  std::string integrator = "generalized-alpha";  // or "hht"
+  /// By name (see integrator_names()): "generalized-alpha" or "hht" (fixed step, or error
+  /// control when generalized_alpha.adaptive is set), "dopri5" (error control).
+  std::string integrator = "generalized-alpha";
+  /// Local error tolerances of the runs with error control, per component of (q, v).
+  double rtol = 1e-6;
+  double atol = 1e-6;
+  double max_step = 0.0;  // s; 0: no limit
   GeneralizedAlphaSettings generalized_alpha = {};
+  DormandPrinceSettings dormand_prince = {};
   AssemblySettings assembly = {};
 };
 
@@ -42,57 +56,95 @@ std::pair<double, double> constraint_residuals(const Model& model, const Workspa
   return {ws.phi.norm(), velocity_residual.norm()};
 }
 
-/// Advances the integrator to `t_target` in equal steps no longer than `max_step`. A step in
-/// which an element's event function crosses zero is cut back to end on the switch (found by
-/// the Illinois variant of regula falsi on the step size), then the integrator restarts.
+namespace detail {
+
+/// A step of size h from the committed state has just carried an element's event function from
+/// g_start < 0 to g_end >= 0. Cuts the step back to end on the switch (the Illinois variant of
+/// regula falsi on the step size), commits it and restarts the integrator under the new law.
 template <class Model, class Integrator>
+void end_step_on_switch(const Model& model, Workspace<Model>& ws, Integrator& integrator, double h,
+                        double g_start, double g_end, double event_time_tolerance) {
+  // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi). Trials stay a little longer
+  // than nothing: an index-3 step of a few femtoseconds turns the rounding in Phi into large
+  // velocity errors (the switch is then located to within min_trial).
+  const double min_trial = std::max(event_time_tolerance, 1e-6 * h);
+  double lo = 0.0, hi = h, g_lo = g_start, g_hi = g_end;
+  int stale_side = 0;
+  while (hi - lo > event_time_tolerance) {
+    double trial = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+    if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
+    trial = std::max(trial, min_trial);
+    if (trial >= hi) break;
+    if (!integrator.attempt(trial)) integrator.fail();
+    const double g = event_function(model, ws);
+    if (g >= 0.0) {
+      hi = trial, g_hi = g;
+      if (stale_side == 1) g_lo *= 0.5;  // Illinois: keep the other end moving
+      stale_side = 1;
+    } else {
+      lo = trial, g_lo = g;
+      if (stale_side == -1) g_hi *= 0.5;
+      stale_side = -1;
+    }
+  }
+  // End just past the switch, so that the element moves on to its next law. Solved again, the
+  // step may land a hair before it (Newton stops within its tolerance, on another path): then
+  // end a little later, or the next step would meet the same switch.
+  double end = hi;
+  for (int extension = 0;; ++extension) {
+    if (!integrator.attempt(end)) integrator.fail();
+    if (event_function(model, ws) >= 0.0 || extension == 10 || end >= h) break;
+    end = std::min(h, end + std::ldexp(min_trial, extension));
+  }
+  integrator.commit();
+  integrator.restart();
+  integrator.count_event();
+}
+
+}  // namespace detail
+
+/// Advances an integrator to `t_target`, landing on it exactly. A fixed-step integrator takes
+/// equal steps no longer than `fixed_step`; an adaptive one takes the steps its error control
+/// proposes (never longer than `max_step`), and a rejected step is tried again shorter. A step in
+/// which an element's event function crosses zero is cut back to end on the switch, then the
+/// integrator restarts.
+template <class Model, StepIntegrator Integrator>
 void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator, double t_target,
-                double max_step, double event_time_tolerance = 1e-12) {
+                double fixed_step, double event_time_tolerance = 1e-12) {
+  constexpr bool can_adapt = AdaptiveIntegrator<Integrator>;
+  const bool adaptive = can_adapt && integrator.adaptive();
   while (integrator.time() < t_target - 1e-12 * std::max(1.0, std::abs(t_target))) {
     const double remaining = t_target - integrator.time();
-    const double steps = std::ceil(remaining / max_step - 1e-9);
-    const double h = remaining / std::max(1.0, steps);
+    double h = 0.0;
+    if constexpr (can_adapt) h = integrator.proposed_step();
+    if (!adaptive) {
+      const double steps = std::ceil(remaining / fixed_step - 1e-9);
+      h = remaining / std::max(1.0, steps);
+    } else if (h >= remaining) {
+      h = remaining;
+    } else if (h > 0.5 * remaining) {
+      h = 0.5 * remaining;  // two even steps rather than a sliver before the target
+    }
     double g_start = 0.0;
     if constexpr (has_events<Model>()) g_start = event_function(model, ws);
-    if (!integrator.attempt(h)) integrator.fail();
+    const bool computed = integrator.attempt(h);
+    if constexpr (can_adapt) {
+      if (adaptive && !(computed && integrator.error_norm() <= 1.0)) {
+        integrator.reject();
+        continue;
+      }
+    }
+    if (!computed) integrator.fail();
     if constexpr (has_events<Model>()) {
-      double g_end = event_function(model, ws);
+      const double g_end = event_function(model, ws);
       if (g_end >= 0.0 && g_start < 0.0) {
-        // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi). Trials stay a little
-        // longer than nothing: an index-3 step of a few femtoseconds turns the rounding in
-        // Phi into large velocity errors (the switch is then located to within min_trial).
-        const double min_trial = std::max(event_time_tolerance, 1e-6 * h);
-        double lo = 0.0, hi = h, g_lo = g_start, g_hi = g_end;
-        int stale_side = 0;
-        while (hi - lo > event_time_tolerance) {
-          double trial = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-          if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
-          trial = std::max(trial, min_trial);
-          if (trial >= hi) break;
-          if (!integrator.attempt(trial)) integrator.fail();
-          const double g = event_function(model, ws);
-          if (g >= 0.0) {
-            hi = trial, g_hi = g;
-            if (stale_side == 1) g_lo *= 0.5;  // Illinois: keep the other end moving
-            stale_side = 1;
-          } else {
-            lo = trial, g_lo = g;
-            if (stale_side == -1) g_hi *= 0.5;
-            stale_side = -1;
-          }
-        }
-        // End just past the switch, so that the element moves on to its next law. Solved
-        // again, the step may land a hair before it (Newton stops within its tolerance, on
-        // another path): then end a little later, or the next step would meet the same switch.
-        double end = hi;
-        for (int extension = 0;; ++extension) {
-          if (!integrator.attempt(end)) integrator.fail();
-          if (event_function(model, ws) >= 0.0 || extension == 10 || end >= h) break;
-          end = std::min(h, end + std::ldexp(min_trial, extension));
-        }
-        integrator.commit();
-        integrator.restart();
-        integrator.count_event();
+        detail::end_step_on_switch(model, ws, integrator, h, g_start, g_end, event_time_tolerance);
+        continue;
+      }
+    }
+    if constexpr (can_adapt) {
+      if (adaptive) {
+        integrator.accept();
         continue;
       }
     }
@@ -100,28 +152,63 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
   }
 }
 
-/// Runs a dynamic analysis from the workspace's state (assembled first). `observe(ws)` sees the
+namespace detail {
+/// Each integrator's own settings, taken from the analysis settings.
+template <class Settings>
+Settings integrator_settings(const DynamicsSettings& s);
+template <>
+inline GeneralizedAlphaSettings integrator_settings(const DynamicsSettings& s) {
+  GeneralizedAlphaSettings settings = s.generalized_alpha;
+  settings.hht = settings.hht || s.integrator == "hht";
+  return settings;
+}
+template <>
+inline DormandPrinceSettings integrator_settings(const DynamicsSettings& s) {
+  return s.dormand_prince;
+}
+
+inline StepControl step_control(const DynamicsSettings& s) {
+  return StepControl{.rtol = s.rtol, .atol = s.atol, .first_step = s.step,
+                     .max_step = s.max_step > 0.0 ? s.max_step
+                                                  : std::numeric_limits<double>::infinity()};
+}
+}  // namespace detail
+
+/// The integrators that `simulate` knows by name, with what they are.
+inline const std::vector<std::pair<std::string, std::string>>& integrator_names() {
+  static const std::vector<std::pair<std::string, std::string>> names = {
+      {"generalized-alpha",
+       "index-3 generalized-alpha (Chung-Hulbert), fixed step h or, with adaptive, rtol/atol"},
+      {"hht", "index-3 HHT-alpha, fixed step h or, with adaptive, rtol/atol"},
+      {"dopri5", "explicit Dormand-Prince 5(4), index 1 with projection, rtol/atol"},
+  };
+  return names;
+}
+
+/// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
+/// instantiated), from the workspace's state (assembled first). `observe(ws)` sees the
 /// workspace at t0 and at every output time, with frames and element blocks up to date.
-template <class Model, class Observer>
-RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                    Observer&& observe) {
+template <template <class> class IntegratorType, class Model, class Observer>
+RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                         Observer&& observe) {
   if (!(s.step > 0.0) || !(s.output_interval > 0.0) || !(s.t_end >= ws.t))
     throw ModelError("dynamics",
                      "step and output interval must be positive and t_end >= t0 "
                      "(got step " +
                          to_text(s.step) + ", output interval " + to_text(s.output_interval) +
                          ", t_end " + to_text(s.t_end) + ")");
-  if (s.integrator != "generalized-alpha" && s.integrator != "hht")
-    throw ModelError("dynamics",
-                     "unknown integrator '" + s.integrator + "'; choose generalized-alpha or hht");
+  if (!(s.rtol > 0.0) || !(s.atol > 0.0))
+    throw ModelError("dynamics", "rtol and atol must be positive (got rtol " + to_text(s.rtol) +
+                                     ", atol " + to_text(s.atol) + ")");
+  using Integrator = IntegratorType<Model>;
+  static_assert(StepIntegrator<Integrator>);
   const auto start = std::chrono::steady_clock::now();
   RunSummary summary;
   summary.assembly = assemble(model, ws, s.assembly);
   require_independent_constraints(model, ws);
-
-  GeneralizedAlphaSettings integrator_settings = s.generalized_alpha;
-  integrator_settings.hht = s.integrator == "hht";
-  GeneralizedAlpha<Model> integrator(model, ws, integrator_settings);
+  Integrator integrator(model, ws,
+                        detail::integrator_settings<typename Integrator::Settings>(s),
+                        detail::step_control(s));
 
   auto record = [&] {
     const auto [phi_norm, phid_norm] = constraint_residuals(model, ws);
@@ -141,6 +228,18 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
+}
+
+/// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()).
+template <class Model, class Observer>
+RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                    Observer&& observe) {
+  if (s.integrator == "generalized-alpha" || s.integrator == "hht")
+    return simulate_with<GeneralizedAlpha>(model, ws, s, observe);
+  if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);
+  std::string known;
+  for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
+  throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);
 }
 
 }  // namespace odyn

@@ -118,6 +118,21 @@ struct Planar {
     q_out = q_in + increment;
   }
 
+  /// dq/dt for a velocity: the velocity itself.
+  static Configuration configuration_rate(const Eigen::Ref<const Configuration>&,
+                                          const Eigen::Ref<const Velocity>& v) {
+    return v;
+  }
+
+  /// Magnitudes of the coordinates that the velocity components move, for relative error
+  /// tolerances.
+  static Velocity coordinate_scale(const Eigen::Ref<const Configuration>& q) {
+    return q.cwiseAbs();
+  }
+
+  /// Every configuration is valid.
+  static void normalize(Eigen::Ref<Configuration>) {}
+
   static MassBlock mass_block(double mass, Inertia inertia) {
     return Eigen::Vector3d(mass, mass, inertia).asDiagonal();
   }

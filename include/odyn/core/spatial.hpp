@@ -122,6 +122,28 @@ struct Spatial {
     q_out.tail<4>() << rotated.w(), rotated.x(), rotated.y(), rotated.z();
   }
 
+  /// dq/dt for a velocity: the centre of mass moves with v, the quaternion turns as
+  /// q' = q (0, w) / 2. Explicit integrators step q in R^7 with it and renormalize.
+  static Configuration configuration_rate(const Eigen::Ref<const Configuration>& q,
+                                          const Eigen::Ref<const Velocity>& v) {
+    Configuration rate;
+    rate.head<3>() = v.head<3>();
+    const Eigen::Quaterniond turned = orientation(q) * Eigen::Quaterniond(0.0, v[3], v[4], v[5]);
+    rate.tail<4>() << 0.5 * turned.w(), 0.5 * turned.x(), 0.5 * turned.y(), 0.5 * turned.z();
+    return rate;
+  }
+
+  /// Magnitudes of the coordinates that the velocity components move, for relative error
+  /// tolerances: the centre of mass's, and 1 for the rotation (radians).
+  static Velocity coordinate_scale(const Eigen::Ref<const Configuration>& q) {
+    Velocity scale;
+    scale << q.head<3>().cwiseAbs(), 1.0, 1.0, 1.0;
+    return scale;
+  }
+
+  /// The nearest valid configuration: the quaternion scaled to unit length.
+  static void normalize(Eigen::Ref<Configuration> q) { q.tail<4>().normalize(); }
+
   static MassBlock mass_block(double mass, const Inertia& inertia) {
     MassBlock m = MassBlock::Zero();
     m.topLeftCorner<3, 3>().diagonal().setConstant(mass);

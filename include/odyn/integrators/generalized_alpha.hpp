@@ -17,6 +17,7 @@
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/integrators/integrator.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -34,16 +35,11 @@ struct GeneralizedAlphaSettings {
   int max_iterations = 8;
   /// Keep the factorization while a step needs no more than this many iterations.
   int reuse_iterations = 2;
-};
-
-struct IntegratorStatistics {
-  long steps = 0;
-  long newton_iterations = 0;
-  long factorizations = 0;
-  long residual_evaluations = 0;
-  long rejected_steps = 0;
-  long restarts = 0;  // after discontinuities
-  long events = 0;    // located switches of force laws
+  /// Step-size control from the local error estimate, with the tolerances of StepControl;
+  /// otherwise fixed steps.
+  bool adaptive = false;
+  /// Largest factor by which an adaptive step may grow from one step to the next.
+  double max_growth = 2.0;
 };
 
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
@@ -53,8 +49,19 @@ class GeneralizedAlpha {
   static constexpr int nv = Model::nv;
   static constexpr int nq = Model::nq;
 
-  GeneralizedAlpha(const Model& model, Workspace<Model>& ws, Settings settings = {})
-      : model_(model), ws_(ws), settings_(settings) {
+  GeneralizedAlpha(const Model& model, Workspace<Model>& ws, Settings settings = {},
+                   StepControl control = {})
+      : model_(model),
+        ws_(ws),
+        settings_(settings),
+        control_(control),
+        proposed_step_(std::min(control.first_step, control.max_step)) {
+    if (settings.adaptive && (!(control.rtol > 0.0) || !(control.atol > 0.0) ||
+                              !(proposed_step_ > 0.0)))
+      throw ModelError(settings.hht ? "hht" : "generalized-alpha",
+                       "rtol, atol and the first step must be positive, got " +
+                           to_text(control.rtol) + ", " + to_text(control.atol) + " and " +
+                           to_text(proposed_step_));
     const double rho = settings.rho_inf;
     if (!(rho >= 0.0 && rho <= 1.0))
       throw ModelError("generalized-alpha", "rho_inf must lie in [0, 1], got " + to_text(rho));
@@ -77,6 +84,13 @@ class GeneralizedAlpha {
     correction_ = Eigen::VectorXd::Zero(n);
     increment_ = Eigen::VectorXd::Zero(nv_total_);
     jerk_ = Eigen::VectorXd::Zero(nv_total_);
+    a_step_ = Eigen::VectorXd::Zero(nv_total_);
+    a_previous_ = Eigen::VectorXd::Zero(nv_total_);
+    local_error_ = Eigen::VectorXd::Zero(nv_total_);
+    error_scale_ = Eigen::VectorXd::Zero(nv_total_);
+    // q(t + h) - q_{n+1} = c h^3 (d/dt)^3 q + O(h^4) when a_n stands for v' at
+    // t_n + (alpha_m - alpha_f) h: the constant c of the position update's local error.
+    error_constant_ = beta_ - 1.0 / 6.0 + 0.5 * (alpha_m_ - alpha_f_);
     inverse_mass_diagonal_ = Eigen::VectorXd::Zero(nv_total_);
     for (int b = 1; b <= model.num_bodies(); ++b)
       inverse_mass_diagonal_.template segment<nv>((b - 1) * nv) =
@@ -109,11 +123,22 @@ class GeneralizedAlpha {
   /// state (frames and blocks evaluated there). False if Newton failed even with a fresh matrix.
   bool attempt(double h) {
     h_ = h;
-    if (starting_) a_n_ = vdot_n_ + (alpha_m_ - alpha_f_) * h * jerk_;
+    // a_n stands for v' at t_n + (alpha_m - alpha_f) h: shift it to this step's size (Arnold &
+    // Bruls' starting value after a restart, a first-order correction after a change of h).
+    if (starting_)
+      a_step_ = vdot_n_ + (alpha_m_ - alpha_f_) * h * jerk_;
+    else if (h != previous_step_)
+      a_step_ = a_n_ + ((alpha_m_ - alpha_f_) * (h - previous_step_) / previous_step_) *
+                           (a_n_ - a_previous_);
+    else
+      a_step_ = a_n_;
     const double t_new = t_n_ + h;
     for (int attempt = 0; attempt < 2; ++attempt) {
       const bool fresh = !factorized_;
-      if (solve_step(t_new)) return true;
+      if (solve_step(t_new)) {
+        estimate_error();
+        return true;
+      }
       // A stale factorization may be the cause: retry once with a fresh one.
       ++statistics_.rejected_steps;
       factorized_ = false;
@@ -122,9 +147,36 @@ class GeneralizedAlpha {
     return false;
   }
 
+  /// Accepts the last attempt and proposes the next step size from its error.
+  void accept() {
+    commit();
+    const double grown = h_ * step_factor(error_, 2, 0.2, settings_.max_growth);
+    // A step cut short to land on an output time says nothing against the longer step.
+    proposed_step_ =
+        std::min(control_.max_step, h_ < proposed_step_ ? std::max(proposed_step_, grown) : grown);
+  }
+
+  /// Rejects the last attempt and proposes a shorter step; throws once it is hopelessly short.
+  void reject() {
+    ++statistics_.rejected_steps;
+    const bool computed = std::isfinite(error_);
+    proposed_step_ = h_ * (computed ? std::min(0.9, step_factor(error_, 2, 0.2, 0.9)) : 0.25);
+    if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_))) {
+      if (!computed) fail();
+      rollback();
+      throw SolverError(t_n_ + h_, "the step size fell below " + to_text(control_.min_step) +
+                                       " s without meeting the tolerances; loosen rtol/atol or "
+                                       "look for a discontinuity that no event locates");
+    }
+    rollback();
+  }
+
   /// Accepts the trial state of the last successful attempt.
   void commit() {
-    a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_n_) / (1.0 - alpha_m_);
+    statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
+    a_previous_ = a_step_;
+    a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) /
+           (1.0 - alpha_m_);
     vdot_previous_ = vdot_n_;
     lambda_previous_ = lambda_n_;
     previous_step_ = h_;
@@ -184,7 +236,11 @@ class GeneralizedAlpha {
     throw SolverError(t_failed, message);
   }
 
+  bool adaptive() const { return settings_.adaptive; }
   double time() const { return t_n_; }
+  double proposed_step() const { return proposed_step_; }
+  /// Local error of the last attempt in units of the tolerance.
+  double error_norm() const { return error_; }
   void count_event() { ++statistics_.events; }
   const IntegratorStatistics& statistics() const { return statistics_; }
   const Settings& settings() const { return settings_; }
@@ -217,9 +273,9 @@ class GeneralizedAlpha {
     const double one_minus_am = 1.0 - alpha_m_;
     // a_{n+1} stored in increment_ first, then turned into the configuration increment.
     increment_ =
-        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_n_) / one_minus_am;
-    ws_.v = v_n_ + h * (1.0 - gamma_) * a_n_ + h * gamma_ * increment_;
-    increment_ = h * v_n_ + h * h * (0.5 - beta_) * a_n_ + h * h * beta_ * increment_;
+        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / one_minus_am;
+    ws_.v = v_n_ + h * (1.0 - gamma_) * a_step_ + h * gamma_ * increment_;
+    increment_ = h * v_n_ + h * h * (0.5 - beta_) * a_step_ + h * h * beta_ * increment_;
     for (int b = 0; b < model_.num_bodies(); ++b)
       Model::Space::integrate(q_n_.template segment<nq>(b * nq),
                               increment_.template segment<nv>(b * nv),
@@ -241,12 +297,27 @@ class GeneralizedAlpha {
     return residual_.allFinite();
   }
 
+  /// Local error of the positions, c h^2 (a_{n+1} - a_n) in the bodies' tangent coordinates
+  /// (Geradin & Cardona, "Flexible Multibody Dynamics", Sect. 13.6), weighted by the tolerances.
+  void estimate_error() {
+    local_error_ =
+        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / (1.0 - alpha_m_) -
+        a_step_;
+    local_error_ *= error_constant_ * h_ * h_;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      error_scale_.template segment<nv>(b * nv) =
+          Model::Space::coordinate_scale(ws_.q.template segment<nq>(b * nq));
+    error_ = weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol,
+                               control_.atol);
+  }
+
   /// d(q_{n+1})/d(v'_{n+1}) and d(v_{n+1})/d(v'_{n+1}).
   double position_factor() const { return beta_ * h_ * h_ * (1.0 - alpha_f_) / (1.0 - alpha_m_); }
   double velocity_factor() const { return gamma_ * h_ * (1.0 - alpha_f_) / (1.0 - alpha_m_); }
 
   bool factorize() {
     ++statistics_.factorizations;
+    ++statistics_.jacobian_evaluations;
     factorized_ =
         solver_.factorize(model_, ws_, IterationFactors{1.0, position_factor(), velocity_factor()});
     return factorized_;
@@ -342,6 +413,10 @@ class GeneralizedAlpha {
   const Model& model_;
   Workspace<Model>& ws_;
   Settings settings_;
+  StepControl control_;
+  double proposed_step_ = 0.0;
+  double error_ = 0.0;           // local error of the last attempt, in units of the tolerance
+  double error_constant_ = 0.0;  // of the position update's local error
   double alpha_m_ = 0.0, alpha_f_ = 0.0, gamma_ = 0.5, beta_ = 0.25;
   double h_ = 0.0;
   double t_n_ = 0.0;
@@ -357,6 +432,9 @@ class GeneralizedAlpha {
   Eigen::VectorXd jerk_;                                 // (nv_total) v'' at the last restart
   bool starting_ = false;      // the next step is the first after a restart
   Eigen::VectorXd increment_;  // (nv_total) configuration increment
+  Eigen::VectorXd a_step_;      // (nv_total) a_n shifted to the size of the attempted step
+  Eigen::VectorXd a_previous_;  // (nv_total) a_{n-1}
+  Eigen::VectorXd local_error_, error_scale_;  // (nv_total)
   Solver solver_;
   IntegratorStatistics statistics_;
 };
