@@ -1,13 +1,11 @@
 #!/usr/bin/env bash
-# Builds and runs the engine example; writes engine.csv in the repository root.
-# Extra arguments are passed on to the example: scripts/run_engine.sh --some-flag value
+# The main job: runs the engine scene (examples/engine.json) through the odyn command line and
+# writes, in the repository root, engine.csv (the columns of examples/engine.cpp) and the paper's
+# two figures (engine_piston.png, engine_bearing.png); prints a summary. scripts/setup.sh first
+# installs what is missing (Debian packages, .venv, the odyn package), so the script is safe to
+# run twice. Extra arguments go to `odyn run`: scripts/run_engine.sh --h 5e-5 --integrator hht
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 bash scripts/setup.sh
-export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true  # as in test.sh, so the two share ccache entries
-gen=(-G Ninja)
-[[ -f build/CMakeCache.txt ]] && gen=()  # an existing tree keeps its generator
-cmake -S . -B build "${gen[@]}" -DODYN_BUILD_EXAMPLES=ON
-cmake --build build --target engine -j "$(nproc)"
-./build/examples/engine --out engine.csv "$@"
+.venv/bin/odyn run examples/engine.json --out engine.csv --figures . "$@"

@@ -1,5 +1,6 @@
-"""odyn: multibody dynamics (rigid bodies, joints, drivers, forces; assembly; Lie-group
-generalized-alpha dynamics), with the C++ library's elements compiled in.
+"""odyn: multibody dynamics (rigid bodies, joints, drivers, forces; assembly; dynamics with
+generalized-alpha, HHT or Dormand-Prince, by name), with the C++ library's spatial and planar
+elements compiled in.
 
     import odyn
     m = odyn.Model()
@@ -10,6 +11,15 @@ generalized-alpha dynamics), with the C++ library's elements compiled in.
     r = odyn.simulate(m, t_end=2.0, step=1e-3, output_interval=0.01)
     r.reaction("hinge").force      # (n, 3), on the bob, global axes
 
+    p = odyn.PlanarModel()         # x, y, phi per body; 2-vectors, angles, torques as numbers
+    p.add_body(name="bar", mass=1.0, inertia=1 / 12, position=[0.5, 0])
+    p.add_revolute(name="pivot", body_a="ground", body_b="bar", on_b=odyn.frame([-0.5, 0]))
+    p.add_gravity(name="gravity", acceleration=[0, -9.81])
+    r = odyn.simulate(p, t_end=1.0, integrator="dopri5", rtol=1e-8, atol=1e-8)
+    r.body("bar").angle, r.statistics.steps
+
+odyn.integrators(): the integrators by name, with what they are.
+
 Scenes: odyn.load(path) -> Scene (model + analysis settings + outputs), odyn.save(scene, path).
 Command line: odyn run SCENE (python -m odyn run SCENE).
 """
@@ -17,20 +27,25 @@ Command line: odyn run SCENE (python -m odyn run SCENE).
 from . import _core
 from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
-from .model import (Model, constant_velocity, frame, harmonic, motion_function,
-                    polynomial)
-from .results import (BodyHistory, Interrupted, Reaction, Result, assemble,
+from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
+                    motion_function, polynomial)
+from .results import (BodyHistory, Interrupted, PlanarBodyHistory, Reaction,
+                      RedundantConstraintsWarning, Result, Statistics, assemble, integrators,
                       simulate)
 from .scene import Scene, load, loads, save
 
 #: Every element type that Model.add accepts (and scenes, except user_force).
 element_types = tuple(t for t in dict.fromkeys(_core.element_types) if t != "signal_watch")
+#: Every element type that PlanarModel.add accepts.
+planar_element_types = tuple(
+    t for t in dict.fromkeys(_core.planar_element_types) if t != "signal_watch")
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "BodyHistory", "Error", "Interrupted", "Model", "ModelError", "Reaction",
-    "Result", "Scene", "SceneError", "SolverError", "assemble", "constant_velocity",
-    "element_types", "frame", "harmonic", "load", "loads", "motion_function", "polynomial",
-    "save", "simulate",
+    "AssemblyError", "BaseModel", "BodyHistory", "Error", "Interrupted", "Model", "ModelError",
+    "PlanarBodyHistory", "PlanarModel", "Reaction", "RedundantConstraintsWarning", "Result",
+    "Scene", "SceneError", "SolverError", "Statistics", "assemble", "constant_velocity",
+    "element_types", "frame", "harmonic", "integrators", "load", "loads", "motion_function",
+    "planar_element_types", "polynomial", "save", "simulate",
 ]

@@ -100,6 +100,8 @@ def check_frame(x: Any, where: str) -> Dict[str, Any]:
     """A joint frame: {point, axis, reference}; point defaults to the origin, axis to z."""
     if isinstance(x, (list, tuple)) and len(x) in (2, 3) and not _is_number(x[0]):
         x = dict(zip(("point", "axis", "reference"), x))
+    if isinstance(x, Mapping) and x.get("axis") is None:
+        x = {k: v for k, v in x.items() if k != "axis"}
     d = check_keys(x, where, ("point", "axis", "reference"))
     out = {
         "point": check_vector(d.get("point", [0.0, 0.0, 0.0]), f"{where}.point"),
@@ -107,6 +109,25 @@ def check_frame(x: Any, where: str) -> Dict[str, Any]:
     }
     if d.get("reference") is not None:
         out["reference"] = check_vector(d["reference"], f"{where}.reference", nonzero=True)
+    return out
+
+
+def check_planar_frame(x: Any, where: str) -> Dict[str, Any]:
+    """A planar joint frame: {point, axis} in body coordinates; the point defaults to the
+    origin; an axis left out is taken parallel to the other body's axis at the initial pose."""
+    if x is None:
+        x = {}
+    if isinstance(x, (list, tuple)) and len(x) in (1, 2) and not _is_number(x[0]):
+        x = dict(zip(("point", "axis"), x))
+    d = check_keys(x, where, ("point", "axis"))
+    out: Dict[str, Any] = {
+        "point": check_vector(d.get("point", [0.0, 0.0]), f"{where}.point", 2)}
+    if d.get("axis") is not None:
+        axis = check_vector(d["axis"], f"{where}.axis", 2)
+        if math.hypot(*axis) <= 1e-12:
+            fail(f"{where}.axis", "zero-length vector; expected a non-zero direction (leave "
+                 "'axis' out to take the other body's axis)")
+        out["axis"] = axis
     return out
 
 
@@ -163,6 +184,14 @@ def _vector_or_callable(x, where, bodies):
     return x if callable(x) else check_vector(x, where)
 
 
+def _vector2_or_callable(x, where, bodies):
+    return x if callable(x) else check_vector(x, where, 2)
+
+
+def _number_or_callable(x, where, bodies):
+    return x if callable(x) else check_number(x, where)
+
+
 def _optional_callable(x, where, bodies):
     return None if x is None else check_callable(x, where)
 
@@ -179,6 +208,10 @@ KINDS: Dict[str, Callable[[Any, str, List[str]], Any]] = {
     "axes": lambda x, w, b: check_choice(x, w, ("global", "body")),
     "motion": lambda x, w, b: check_motion(x, w),
     "vector_or_callable": _vector_or_callable,
+    "vector2": lambda x, w, b: check_vector(x, w, 2),
+    "planar_frame": lambda x, w, b: check_planar_frame(x, w),
+    "vector2_or_callable": _vector2_or_callable,
+    "number_or_callable": _number_or_callable,
     "optional_callable": _optional_callable,
     "callable": lambda x, w, b: check_callable(x, w),
 }
@@ -227,15 +260,53 @@ FORCES = ("gravity", "point_force", "point_torque", "tsda", "rsda", "engine_gas_
           "user_force")
 assert set(ELEMENTS) == set(JOINTS + DRIVERS + FORCES)
 
+_PLANAR_PAIR = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
+                "on_a": ("planar_frame", None), "body_b": ("body", REQUIRED),
+                "on_b": ("planar_frame", None)}
+_PLANAR_POINTS = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
+                  "point_a": ("vector2", [0.0, 0.0]), "body_b": ("body", REQUIRED),
+                  "point_b": ("vector2", [0.0, 0.0])}
+
+#: Every planar element type (odyn::planar, plus the engine's gas force and Python forces).
+PLANAR_ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
+    "revolute": _PLANAR_PAIR,
+    "translational": _PLANAR_PAIR,
+    "fixed": _PLANAR_PAIR,
+    "distance": {**_PLANAR_POINTS, "length": ("number", 0.0)},
+    "revolute_driver": {**_PLANAR_PAIR, "motion": ("motion", REQUIRED)},
+    "translational_driver": {**_PLANAR_PAIR, "motion": ("motion", REQUIRED)},
+    "gravity": {"name": ("name", REQUIRED), "acceleration": ("vector2", REQUIRED)},
+    "point_force": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
+                    "point": ("vector2", [0.0, 0.0]),
+                    "force": ("vector2_or_callable", REQUIRED), "axes": ("axes", "global")},
+    "point_torque": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
+                     "torque": ("number_or_callable", REQUIRED)},
+    "tsda": {**_PLANAR_POINTS, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
+             "free_length": ("nonnegative", 0.0), "actuator": ("optional_callable", None)},
+    "rsda": {**_PLANAR_PAIR, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
+             "free_angle": ("number", 0.0), "actuator": ("optional_callable", None)},
+    # The engine's gas force in the plane: along y, the crank angle is the crank's angle.
+    "engine_gas_force": ELEMENTS["engine_gas_force"],
+    "user_force": ELEMENTS["user_force"],
+}
+PLANAR_JOINTS = ("revolute", "translational", "fixed", "distance")
+assert set(PLANAR_ELEMENTS) == set(PLANAR_JOINTS + DRIVERS + FORCES)
+
+#: The element catalogue of each space.
+CATALOGUE = {"spatial": ELEMENTS, "planar": PLANAR_ELEMENTS}
+SPACE_JOINTS = {"spatial": JOINTS, "planar": PLANAR_JOINTS}
+
 #: Which joints a driver may name with `joint=` (it takes their bodies and frames).
 DRIVEN_JOINTS = {"revolute_driver": ("revolute",),
                  "translational_driver": ("translational", "cylindrical")}
 
 
 def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: List[str],
-                  elements: Mapping[str, Tuple[str, Dict[str, Any]]]) -> Dict[str, Any]:
-    """Normalized parameters of an element of type `kind`; `elements`: name -> (type, params)."""
-    spec = ELEMENTS[kind]
+                  elements: Mapping[str, Tuple[str, Dict[str, Any]]],
+                  space: str = "spatial") -> Dict[str, Any]:
+    """Normalized parameters of an element of type `kind` in `space`; `elements`: name ->
+    (type, params)."""
+    spec = CATALOGUE[space][kind]
     params = dict(params)
     if kind in DRIVERS and "joint" in params:
         # Drive an existing joint: take its bodies and frames.
@@ -252,6 +323,8 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: List
     out: Dict[str, Any] = {}
     for key, (param_kind, default) in spec.items():
         value = params.get(key, default)
+        if value is None and param_kind == "planar_frame":  # the body's origin, axis left out
+            value = {}
         out[key] = KINDS[param_kind](value, f"{where}.{key}", bodies)
     if out["name"] in elements or out["name"] in bodies:
         fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
@@ -292,10 +365,25 @@ def check_inertia(x: Any, where: str) -> List[List[float]]:
     raise AssertionError
 
 
-def check_body(params: Mapping[str, Any], where: str, names: Sequence[str]) -> Dict[str, Any]:
-    check_keys(params, where, list(BODY), [k for k, (_, d) in BODY.items() if d is REQUIRED])
+PLANAR_BODY: Dict[str, Tuple[str, Any]] = {
+    "name": ("name", REQUIRED),
+    "mass": ("positive", REQUIRED),
+    "inertia": ("positive", REQUIRED),
+    "position": ("vector2", [0.0, 0.0]),
+    "angle": ("number", 0.0),
+    "linear_velocity": ("vector2", [0.0, 0.0]),
+    "angular_velocity": ("number", 0.0),
+    "velocity_given": ("flags", None),
+}
+
+
+def check_body(params: Mapping[str, Any], where: str, names: Sequence[str],
+               space: str = "spatial") -> Dict[str, Any]:
+    spec = PLANAR_BODY if space == "planar" else BODY
+    flags = 3 if space == "planar" else 6
+    check_keys(params, where, list(spec), [k for k, (_, d) in spec.items() if d is REQUIRED])
     out: Dict[str, Any] = {}
-    for key, (kind, default) in BODY.items():
+    for key, (kind, default) in spec.items():
         value = params.get(key, default)
         w = f"{where}.{key}"
         if kind == "inertia":
@@ -303,10 +391,10 @@ def check_body(params: Mapping[str, Any], where: str, names: Sequence[str]) -> D
         elif kind == "quaternion":
             out[key] = check_vector(value, w, 4, nonzero=True)
         elif kind == "flags":
-            if value is not None and (not isinstance(value, (list, tuple)) or len(value) != 6
+            if value is not None and (not isinstance(value, (list, tuple)) or len(value) != flags
                                       or not all(isinstance(f, bool) for f in value)):
-                fail(w, f"expected a list of 6 booleans (linear x y z, angular x y z), got "
-                     f"{_describe(value)}")
+                what = "x', y', phi'" if space == "planar" else "linear x y z, angular x y z"
+                fail(w, f"expected a list of {flags} booleans ({what}), got {_describe(value)}")
             out[key] = None if value is None else list(value)
         else:
             out[key] = KINDS[kind](value, w, [])

@@ -1,4 +1,5 @@
-"""Command line: odyn run SCENE [options], odyn check SCENE (also python -m odyn)."""
+"""Command line: odyn run SCENE [options], odyn check SCENE, odyn integrators (also
+python -m odyn)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from typing import List, NoReturn, Optional
 import numpy as np
 
 from . import _core
-from .results import INTEGRATORS, Interrupted, Result
+from .results import ADAPTIVE_OPTIONAL, Interrupted, Result, integrators
 from .scene import Scene, load, write_table
 
 
@@ -29,8 +30,14 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--t-end", type=float, help="end time, s")
     run.add_argument("--h", type=float, dest="step", help="step size, s")
     run.add_argument("--dt-out", type=float, dest="output_interval", help="output interval, s")
-    run.add_argument("--integrator", choices=INTEGRATORS)
-    run.add_argument("--rho-inf", type=float)
+    names = list(integrators())
+    run.add_argument("--integrator", choices=names, metavar="NAME",
+                     help=f"one of {', '.join(names)} (odyn integrators describes them)")
+    run.add_argument("--rho-inf", type=float, help="generalized-alpha and hht: rho_inf")
+    run.add_argument("--rtol", type=float, help="relative local error tolerance (turns on "
+                     "error control for generalized-alpha and hht; --h is then the first step)")
+    run.add_argument("--atol", type=float, help="absolute local error tolerance (likewise)")
+    run.add_argument("--max-step", type=float, help="largest step with error control, s")
     run.add_argument("--out", help="write the output columns to a .csv or .npz file")
     run.add_argument("--plot", help="draw every output column against t into this image")
     run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
@@ -39,6 +46,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
     check = sub.add_parser("check", help="check a scene file and describe its model")
     check.add_argument("scene")
+    sub.add_parser("integrators", help="list the integrators, by name")
     return p
 
 
@@ -66,22 +74,46 @@ class _Progress:
             sys.stderr.flush()
 
 
+def describe_integrator(settings: dict) -> str:
+    """"generalized-alpha (rho_inf 0.9), h = 0.0001 s" or, with error control, "... rtol ..."."""
+    name = settings["integrator"]
+    text = name + (f" (rho_inf {settings['rho_inf']:g})" if name in ADAPTIVE_OPTIONAL else "")
+    adaptive = settings.get("adaptive")
+    if adaptive is None:  # as simulate(): tolerances turn on error control
+        adaptive = name not in ADAPTIVE_OPTIONAL or "rtol" in settings or "atol" in settings
+    if adaptive:
+        text += (f", error control rtol {settings.get('rtol', 1e-6):g}, atol "
+                 f"{settings.get('atol', 1e-6):g}, first step {settings['step']:g} s")
+        if settings.get("max_step"):
+            text += f", max step {settings['max_step']:g} s"
+        return text
+    return text + f", h = {settings['step']:g} s"
+
+
 def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> List[str]:
     s = result.summary or {}
-    lines = [f"{settings['integrator']} (rho_inf {settings['rho_inf']:g}), "
-             f"h = {settings['step']:g} s, t_end = {settings['t_end']:g} s: {len(result)} outputs"
-             + ("  [INTERRUPTED]" if result.interrupted else "")]
+    lines = [f"{describe_integrator(settings)}, t_end = {settings['t_end']:g} s: "
+             f"{len(result)} outputs" + ("  [INTERRUPTED]" if result.interrupted else "")]
+    m = scene.model
+    lines.append(f"  {m.space} model: {m.num_velocities} coordinates, {m.num_equations} "
+                 "constraint equations")
     if s:
         steps = s["steps"]
         lines.append(f"  steps {steps} (events {s['events']}, rejected {s['rejected_steps']}), "
                      f"Newton iterations {s['newton_iterations']} "
                      f"({s['newton_iterations'] / max(steps, 1):.2f} per step), "
+                     f"Jacobians {s['jacobian_evaluations']}, "
                      f"factorizations {s['factorizations']}")
+        lines.append(f"  largest local error estimate {s['max_error_estimate']:.3g} "
+                     "(in units of rtol, atol)")
         lines.append(f"  wall time {s['wall_seconds']:.3f} s "
                      f"({1e6 * s['wall_seconds'] / max(steps, 1):.2f} us per step)")
     else:
         lines.append(f"  stopped at t = {result.t[-1] if len(result) else 0.0:g} s "
                      f"after {wall:.3f} s")
+    if result.redundant_equations:
+        lines.append("  redundant constraint equations (minimum-norm reactions): " + ", ".join(
+            f"{e['joint']} (equation {e['equation']})" for e in result.redundant_equations))
     if len(result):
         lines.append(f"  largest residuals: |Phi| {np.max(result.phi_norm):.2e}, "
                      f"|Phi_q v + Phi_t| {np.max(result.phid_norm):.2e}")
@@ -98,10 +130,15 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
 def _run(args: argparse.Namespace) -> int:
     scene = load(args.scene)
     settings = dict(scene.analysis)
-    for key in ("t_end", "step", "output_interval", "integrator", "rho_inf"):
+    for key in ("t_end", "step", "output_interval", "integrator", "rho_inf", "rtol", "atol",
+                "max_step"):
         value = getattr(args, key)
         if value is not None:
             settings[key] = value
+    if settings["integrator"] not in ADAPTIVE_OPTIONAL:
+        settings.pop("adaptive", None)  # the scene's choice for another integrator
+    elif args.rtol is not None or args.atol is not None:
+        settings["adaptive"] = True  # as the C++ examples: tolerances turn on error control
     if args.out and not args.out.endswith((".csv", ".npz")):
         raise ValueError(f"--out {args.out}: expected a .csv or .npz file name")
     progress = _Progress(settings["t_end"], not args.quiet and sys.stderr.isatty())
@@ -149,19 +186,27 @@ def _check(args: argparse.Namespace) -> int:
     scene = load(args.scene)
     m = scene.model
     print(f"odyn: {args.scene}: valid scene")
-    print(f"  {m.num_bodies} moving bodies ({', '.join(m.body_names[1:])}), "
+    print(f"  {m.space} model: {m.num_bodies} moving bodies ({', '.join(m.body_names[1:])}), "
           f"{len(m.element_names)} elements, {m.num_equations} constraint equations, "
-          f"{6 * m.num_bodies - m.num_equations} degrees of freedom if none is redundant")
+          f"{m.num_velocities - m.num_equations} degrees of freedom if none is redundant")
     a = scene.analysis
-    print(f"  analysis: {a['integrator']}, rho_inf {a['rho_inf']:g}, h {a['step']:g} s, "
-          f"t_end {a['t_end']:g} s, output every {a['output_interval']:g} s")
+    print(f"  analysis: {describe_integrator(a)}, t_end {a['t_end']:g} s, output every "
+          f"{a['output_interval']:g} s")
     print(f"  outputs: t, {', '.join(o['name'] for o in scene.outputs)}")
+    return 0
+
+
+def _integrators() -> int:
+    for name, what in integrators().items():
+        print(f"{name:20} {what}")
     return 0
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     args = _parser().parse_args(argv)
     try:
+        if args.command == "integrators":
+            return _integrators()
         return _run(args) if args.command == "run" else _check(args)
     except (_core.Error, ValueError, OSError) as e:
         print(f"odyn: {e}", file=sys.stderr)

@@ -97,15 +97,24 @@ def _attachments(model: Any) -> list:
     return links
 
 
+def _planar_rotations(angles: np.ndarray) -> np.ndarray:
+    """(n, 2, 2) body-to-global rotations from (n,) angles."""
+    c, s = np.cos(angles), np.sin(angles)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
 def animate(result: Any, model: Any, path: str, *, frames: int = 60, fps: int = 15,
             title: str = "") -> None:
-    """A GIF of any mechanism: each body a dot at its centre of mass with sticks to the points
-    where joints and springs attach it; each link drawn between its two points."""
+    """A GIF of any mechanism (spatial in 3D, planar in the plane): each body a dot at its
+    centre of mass with sticks to the points where joints and springs attach it; each link
+    drawn between its two points."""
     plt = _pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
 
+    planar = getattr(result, "space", "spatial") == "planar"
     names = result.body_names
-    rotations = {b: _rotations(result.body(b).orientation) for b in names}
+    rotations = {b: _planar_rotations(result.body(b).angle) if planar
+                 else _rotations(result.body(b).orientation) for b in names}
     centres = {b: result.body(b).position for b in names}
 
     def point(body: str, local: Sequence[float], k: int) -> np.ndarray:
@@ -121,7 +130,7 @@ def animate(result: Any, model: Any, path: str, *, frames: int = 60, fps: int = 
     middle, half = (low + high) / 2, max(1e-3, float(np.max(high - low)) / 2 * 1.1)
 
     fig = plt.figure(figsize=(5, 5))
-    ax = fig.add_subplot(projection="3d")
+    ax = fig.add_subplot() if planar else fig.add_subplot(projection="3d")
 
     def draw(i: int) -> None:
         k = picks[i]
@@ -137,10 +146,15 @@ def animate(result: Any, model: Any, path: str, *, frames: int = 60, fps: int = 
             ax.scatter(*centres[body][k], color="tab:blue", s=20)
         ax.set_xlim(middle[0] - half, middle[0] + half)
         ax.set_ylim(middle[1] - half, middle[1] + half)
-        ax.set_zlim(middle[2] - half, middle[2] + half)
-        ax.set_xlabel("X")
-        ax.set_ylabel("Y")
-        ax.set_zlabel("Z")
+        if planar:
+            ax.set_aspect("equal")
+            ax.set_xlabel("x  [m]")
+            ax.set_ylabel("y  [m]")
+        else:
+            ax.set_zlim(middle[2] - half, middle[2] + half)
+            ax.set_xlabel("X")
+            ax.set_ylabel("Y")
+            ax.set_zlabel("Z")
         ax.set_title(f"{title}  t = {result.t[k]:.3f} s".strip())
 
     animation = FuncAnimation(fig, draw, frames=len(picks))

@@ -2,14 +2,33 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Callable, Dict, List, NamedTuple, Optional
 
 import numpy as np
 
 from . import _core
-from .model import Model
+from ._schema import SceneError, check_choice, check_number
+from .model import BaseModel
 
-INTEGRATORS = ("generalized-alpha", "hht")
+#: Integrators whose step is fixed unless `adaptive` (error control) is on.
+ADAPTIVE_OPTIONAL = ("generalized-alpha", "hht")
+
+
+def integrators() -> Dict[str, str]:
+    """The integrators `simulate` knows, by name, with a description (from the C++ library's
+    odyn::integrator_names(), so a new C++ integrator appears here by itself)."""
+    return dict(_core.integrators())
+
+
+#: Integrator names when the package was imported (`integrators()` is the function to call).
+INTEGRATORS = tuple(integrators())
+
+
+class RedundantConstraintsWarning(UserWarning):
+    """Some constraint equations repeat others at the assembled pose (the mechanism is
+    over-constrained, consistently). The analysis goes on with the minimum-norm multipliers, so
+    the reactions of the joints named are one choice among many."""
 
 
 class Interrupted(KeyboardInterrupt):
@@ -22,8 +41,34 @@ class Interrupted(KeyboardInterrupt):
 
 
 class Reaction(NamedTuple):
-    force: np.ndarray   # (n, 3)
-    torque: np.ndarray  # (n, 3), about the joint point
+    force: np.ndarray   # (n, 3); planar (n, 2)
+    torque: np.ndarray  # (n, 3), about the joint point; planar (n,)
+
+
+class Statistics(NamedTuple):
+    """What a dynamic analysis counted (the C++ IntegratorStatistics and RunSummary)."""
+    steps: int                  # accepted steps
+    rejected_steps: int         # attempts thrown away (error too large or Newton failed)
+    newton_iterations: int      # linear solves of Newton iterations (or projections)
+    jacobian_evaluations: int   # iteration matrices assembled
+    factorizations: int
+    residual_evaluations: int   # evaluations of Phi, Phi_q and Q together
+    restarts: int               # after discontinuities and at the start
+    events: int                 # located switches of force laws
+    max_error_estimate: float   # largest local error estimate of a step, in units of rtol/atol
+    outputs: int
+    wall_seconds: float
+    max_position_residual: float  # max |Phi| at the output times
+    max_velocity_residual: float  # max |Phi_q v + Phi_t| at the output times
+
+
+class PlanarBodyHistory(NamedTuple):
+    position: np.ndarray              # (n, 2) centre of mass
+    angle: np.ndarray                 # (n,) rad, counter-clockwise, counting turns
+    linear_velocity: np.ndarray       # (n, 2)
+    angular_velocity: np.ndarray      # (n,)
+    linear_acceleration: np.ndarray   # (n, 2)
+    angular_acceleration: np.ndarray  # (n,)
 
 
 class BodyHistory(NamedTuple):
@@ -38,10 +83,12 @@ class BodyHistory(NamedTuple):
 class Result:
     """Outputs of an analysis, one row per output time.
 
-    Arrays: t (n), q (n x 7 nb), v and vdot (n x 6 nb), lambda_ (n x m), kinetic_energy,
-    potential_energy, total_energy, phi_norm (|Phi|), phid_norm (|Phi_q v + Phi_t|).
+    Arrays: t (n), q (n x 7 nb; planar n x 3 nb), v and vdot (n x 6 nb; planar n x 3 nb),
+    lambda_ (n x m), kinetic_energy, potential_energy, total_energy, phi_norm (|Phi|),
+    phid_norm (|Phi_q v + Phi_t|).
     By name: body(name), reaction(joint, side, axes), multipliers(joint), state(element).
-    summary: steps, Newton iterations, wall time, ... (None when the run stopped early).
+    statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
+    early); summary: the same as a dict, with the assembly report.
     """
 
     def __init__(self, data: Dict[str, Any], interrupted: bool = False) -> None:
@@ -56,7 +103,11 @@ class Result:
         self.total_energy: np.ndarray = self.kinetic_energy + self.potential_energy
         self.phi_norm: np.ndarray = data["phi_norm"]
         self.phid_norm: np.ndarray = data["phid_norm"]
+        self.space: str = data.get("space", "spatial")
         self.summary: Optional[Dict[str, Any]] = data.get("summary")
+        self.statistics: Optional[Statistics] = (
+            Statistics(**{k: self.summary[k] for k in Statistics._fields})
+            if self.summary else None)
         self.assembly: Optional[Dict[str, Any]] = data.get("assembly") or (
             self.summary["assembly"] if self.summary else None)
         self.interrupted = interrupted
@@ -64,6 +115,13 @@ class Result:
 
     def __len__(self) -> int:
         return len(self.t)
+
+    @property
+    def redundant_equations(self) -> List[Dict[str, Any]]:
+        """Constraint equations that repeat others at the assembled pose, each {"joint",
+        "equation" (its index among the joint's equations), "row" (of Phi)}; empty for an
+        ordinary mechanism. Their joints' reactions are the minimum-norm choice."""
+        return list((self.assembly or {}).get("redundant_equations", []))
 
     def __getitem__(self, key: str) -> np.ndarray:
         """result["lambda"] and the other arrays by name."""
@@ -80,11 +138,15 @@ class Result:
         """Every constraint (joints and drivers) with reactions."""
         return list(self._data["reactions"])
 
-    def body(self, name: str) -> BodyHistory:
+    def body(self, name: str) -> Any:
+        """The body's history: a BodyHistory (spatial) or a PlanarBodyHistory (planar)."""
         if name not in self._bodies:
             raise KeyError(f"{name}: no moving body of that name; bodies: "
                            + ", ".join(self._bodies))
         b = self._bodies.index(name)
+        if self.space == "planar":
+            q, v, a = (x[:, 3 * b:3 * b + 3] for x in (self.q, self.v, self.vdot))
+            return PlanarBodyHistory(q[:, :2], q[:, 2], v[:, :2], v[:, 2], a[:, :2], a[:, 2])
         q = self.q[:, 7 * b:7 * b + 7]
         v = self.v[:, 6 * b:6 * b + 6]
         a = self.vdot[:, 6 * b:6 * b + 6]
@@ -101,6 +163,8 @@ class Result:
         if axes not in ("global", "joint"):
             raise ValueError(f"axes must be 'global' or 'joint', got {axes!r}")
         r = self._data["reactions"][joint][:, "ab".index(side), ("global", "joint").index(axes)]
+        if self.space == "planar":
+            return Reaction(r[:, :2], r[:, 2])
         return Reaction(r[:, :3], r[:, 3:])
 
     def multipliers(self, joint: str) -> np.ndarray:
@@ -109,8 +173,9 @@ class Result:
         return self.lambda_[:, row:row + size]
 
     def state(self, element: str) -> Dict[str, np.ndarray]:
-        """The discrete state of a stateful force: rsda {angle}, engine_gas_force {theta,
-        half_turn} (theta: the cumulative crank angle)."""
+        """The discrete state of a stateful force: spatial rsda {angle}, engine_gas_force
+        {theta, half_turn} (theta: the cumulative crank angle). A planar rsda keeps no state:
+        its angle is a difference of body angles."""
         if element not in self._data["states"]:
             raise KeyError(f"{element}: no stateful force of that name; stateful forces: "
                            + ", ".join(self._data["states"]))
@@ -124,6 +189,7 @@ class Result:
             "t", "q", "v", "vdot", "lambda", "kinetic_energy", "potential_energy", "phi_norm",
             "phid_norm")}
         arrays["bodies"] = np.array(self._bodies)
+        arrays["space"] = np.array(self.space)
         for name, values in self._data["reactions"].items():
             arrays[f"reaction/{name}"] = values
         for name, fields in self._data["states"].items():
@@ -144,51 +210,95 @@ class Result:
 
 
 def _settings(step: float, t_end: float, output_interval: float, integrator: str,
-              rho_inf: float, **extra: Any) -> Dict[str, Any]:
-    from ._schema import check_choice, check_number
-    settings = {
+              rho_inf: float, rtol: Optional[float], atol: Optional[float],
+              max_step: Optional[float], adaptive: Optional[bool], **extra: Any) -> Dict[str, Any]:
+    """The settings dict of _core.simulate, checked. `adaptive` None: error control for
+    generalized-alpha and hht exactly when rtol or atol is given (as the C++ examples do)."""
+    names = integrators()
+    settings: Dict[str, Any] = {
         "step": check_number(step, "step", positive=True),
         "t_end": check_number(t_end, "t_end", minimum=0.0),
         "output_interval": check_number(output_interval, "output_interval", positive=True),
-        "integrator": check_choice(integrator, "integrator", INTEGRATORS),
+        "integrator": check_choice(integrator, "integrator", list(names)),
         "rho_inf": check_number(rho_inf, "rho_inf", minimum=0.0),
     }
+    for key, value in (("rtol", rtol), ("atol", atol), ("max_step", max_step)):
+        if value is not None:
+            settings[key] = check_number(value, key, positive=True)
+    if adaptive is not None and not isinstance(adaptive, bool):
+        raise SceneError(f"adaptive: expected true or false, got {adaptive!r}")
+    if integrator in ADAPTIVE_OPTIONAL:
+        settings["adaptive"] = (rtol is not None or atol is not None) if adaptive is None \
+            else adaptive
+    elif adaptive is not None:
+        raise SceneError(f"adaptive: applies to {' and '.join(ADAPTIVE_OPTIONAL)}; {integrator} "
+                         "chooses its steps itself (leave 'adaptive' out)")
     for key, value in extra.items():
         if value is not None:
             settings[key] = value
     return settings
 
 
-def assemble(model: Model, tolerance: float = 1e-12, max_iterations: int = 50) -> Result:
-    """Consistent initial positions, velocities, accelerations and multipliers (one row)."""
+def _warn_redundant(result: Result) -> None:
+    equations = result.redundant_equations
+    if equations:
+        named = ", ".join(f"{e['joint']} (equation {e['equation']})" for e in equations)
+        warnings.warn(RedundantConstraintsWarning(
+            f"{named}: constraint equations are redundant (they repeat what other joints "
+            "already impose); the analysis uses the minimum-norm multipliers, so these "
+            "reactions are one choice among many. Replace a joint by one with fewer equations "
+            "if you need them."), stacklevel=3)
+
+
+def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 50) -> Result:
+    """Consistent initial positions, velocities, accelerations and multipliers (one row).
+    Redundant constraint equations are listed in `result.redundant_equations` and give a
+    `RedundantConstraintsWarning`."""
     data = _core.assemble(model._core, {"assembly_tolerance": tolerance,
                                         "assembly_max_iterations": max_iterations})
     data["summary"] = None
-    return Result(data)
+    result = Result(data)
+    _warn_redundant(result)
+    return result
 
 
-def simulate(model: Model, *, t_end: float = 1.0, step: float = 1e-4,
+def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
              output_interval: float = 1e-3, integrator: str = "generalized-alpha",
-             rho_inf: float = 0.9, progress: Optional[Callable[[float], None]] = None,
+             rho_inf: float = 0.9, rtol: Optional[float] = None, atol: Optional[float] = None,
+             max_step: Optional[float] = None, adaptive: Optional[bool] = None,
+             progress: Optional[Callable[[float], None]] = None,
              newton_rtol: Optional[float] = None, newton_atol: Optional[float] = None,
              constraint_tolerance: Optional[float] = None,
-             max_iterations: Optional[int] = None) -> Result:
-    """Assembles, then integrates from t = 0 to t_end with fixed steps (at most `step`) that
-    land on every output time; "generalized-alpha" (Chung-Hulbert) or "hht", both from
-    rho_inf. The GIL is released during the run (Python callables take it back per call).
+             max_iterations: Optional[int] = None,
+             projection_tolerance: Optional[float] = None) -> Result:
+    """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
+    integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
+    rho_inf) or "hht" take fixed steps of at most `step`, or, with error control (`adaptive`;
+    on by default when rtol or atol is given), steps from the local error estimate starting at
+    `step`; "dopri5" (explicit Dormand-Prince 5(4), positions projected onto the constraints to
+    `projection_tolerance`) always controls its error. rtol and atol (default 1e-6) are the
+    local error tolerances per component of (q, v); max_step bounds an adaptive step.
+    newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
+    iteration of generalized-alpha and hht.
+
+    The GIL is released during the run (Python callables take it back per call).
     progress(t) is called about every 0.2 s of wall time. Ctrl-C raises `odyn.Interrupted`,
     whose `result` holds the outputs so far; an error during the run gets the partial result
-    as its `result` attribute.
+    as its `result` attribute. A consistently over-constrained mechanism runs with minimum-norm
+    multipliers and a `RedundantConstraintsWarning` (see `Result.redundant_equations`).
     """
-    settings = _settings(step, t_end, output_interval, integrator, rho_inf,
-                         newton_rtol=newton_rtol, newton_atol=newton_atol,
+    settings = _settings(step, t_end, output_interval, integrator, rho_inf, rtol, atol,
+                         max_step, adaptive, newton_rtol=newton_rtol, newton_atol=newton_atol,
                          constraint_tolerance=constraint_tolerance,
-                         max_iterations=max_iterations)
+                         max_iterations=max_iterations,
+                         projection_tolerance=projection_tolerance)
     data = _core.simulate(model._core, settings, progress)
     error = data.pop("error")
     if error is None:
-        return Result(data)
+        result = Result(data)
+        _warn_redundant(result)
+        return result
     result = Result(data, interrupted=True)
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(result) from error

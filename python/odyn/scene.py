@@ -3,6 +3,7 @@
     {
       "odyn": 1,
       "description": "...",
+      "space": "spatial",      (or "planar": 2-vectors, angles, planar elements)
       "bodies":  [{"name": "crank", "mass": 1.4, "inertia": [1.5, 1.3, 0.8], ...}],
       "joints":  [{"type": "revolute", "name": "bearing", "body_a": "ground",
                    "on_a": {"point": [0, 0, 0], "axis": [1, 0, 0]}, "body_b": "crank", ...}],
@@ -10,14 +11,17 @@
                    "motion": {"type": "constant_velocity", "rate": 10.0}}],
       "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
       "analysis": {"integrator": "generalized-alpha", "rho_inf": 0.9, "step": 1e-4,
-                   "t_end": 1.0, "output_interval": 1e-3},
+                   "t_end": 1.0, "output_interval": 1e-3},   (+ rtol, atol, max_step,
+                   adaptive, newton_rtol, newton_atol, constraint_tolerance, max_iterations,
+                   projection_tolerance; the integrator is a name of odyn.integrators())
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"}, ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
     }
 
 Loading checks everything and names the place of each error (``joints[2].on_a.axis: ...``);
-unknown keys are errors. Parameters are named as in C++ (see odyn.Model's add_* methods).
+unknown keys are errors. Parameters are named as in C++ (see the add_* methods of odyn.Model
+and odyn.PlanarModel).
 """
 
 from __future__ import annotations
@@ -31,33 +35,43 @@ import numpy as np
 
 from . import _schema
 from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
-from .model import Model
-from .results import INTEGRATORS, Result, simulate
+from .model import BaseModel, Model, new_model
+from .results import ADAPTIVE_OPTIONAL, Result, integrators, simulate
 
 FORMAT_VERSION = 1
-SECTIONS = {"joints": _schema.JOINTS, "drivers": _schema.DRIVERS,
-            "forces": tuple(t for t in _schema.FORCES if t != "user_force")}
-TOP_KEYS = ("odyn", "description", "bodies", "joints", "drivers", "forces", "analysis",
+SPACES = ("spatial", "planar")
+_SCENE_FORCES = tuple(t for t in _schema.FORCES if t != "user_force")
+#: Element types by section of a scene file, for each space.
+SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _schema.DRIVERS,
+                          "forces": _SCENE_FORCES} for space in SPACES}
+SECTIONS = SPACE_SECTIONS["spatial"]
+TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "analysis",
             "outputs", "figures")
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf": 0.9,
                                      "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
-ANALYSIS_OPTIONAL = ("newton_rtol", "newton_atol", "constraint_tolerance", "max_iterations")
+ANALYSIS_OPTIONAL = ("rtol", "atol", "max_step", "adaptive", "newton_rtol", "newton_atol",
+                     "constraint_tolerance", "max_iterations", "projection_tolerance")
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
+#: Planar body quantities; the angular ones are numbers (no component).
+PLANAR_BODY_QUANTITIES = ("position", "angle", "linear_velocity", "angular_velocity",
+                          "linear_acceleration", "angular_acceleration")
+PLANAR_SCALARS = ("angle", "angular_velocity", "angular_acceleration", "torque")
 GLOBAL_QUANTITIES = ("phi_norm", "phid_norm", "kinetic_energy", "potential_energy",
                      "total_energy")
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
+PLANAR_COMPONENTS = {"x": 0, "y": 1}
 QUATERNION_COMPONENTS = {"w": 0, "x": 1, "y": 2, "z": 3}
 
 
 class Scene:
     """A model with its analysis settings, output columns and figures."""
 
-    def __init__(self, model: Optional[Model] = None, analysis: Optional[Mapping] = None,
+    def __init__(self, model: Optional[BaseModel] = None, analysis: Optional[Mapping] = None,
                  outputs: Optional[List[Dict[str, Any]]] = None,
                  figures: Optional[List[Dict[str, Any]]] = None, description: str = "") -> None:
-        self.model = model if model is not None else Model()
+        self.model: BaseModel = model if model is not None else Model()
         self.analysis: Dict[str, Any] = _check_analysis(dict(analysis or {}), "analysis")
         self.outputs: List[Dict[str, Any]] = [
             _check_output(o, f"outputs[{i}]", self.model) for i, o in enumerate(outputs or [])]
@@ -83,8 +97,9 @@ class Scene:
         out: Dict[str, Any] = {"odyn": FORMAT_VERSION}
         if self.description:
             out["description"] = self.description
+        out["space"] = self.model.space
         out["bodies"] = [_plain(b, f"bodies[{i}]") for i, b in enumerate(self.model._bodies)]
-        for section, kinds in SECTIONS.items():
+        for section, kinds in SPACE_SECTIONS[self.model.space].items():
             entries = []
             for name, (kind, params, _) in self.model._elements.items():
                 if kind == "user_force" and section == "forces":
@@ -128,7 +143,7 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
         value = d.get(key, default)
         w = f"{where}.{key}"
         if key == "integrator":
-            out[key] = check_choice(value, w, INTEGRATORS)
+            out[key] = check_choice(value, w, list(integrators()))
         elif key == "rho_inf":
             out[key] = check_number(value, w, minimum=0.0)
             if out[key] > 1.0:
@@ -139,7 +154,14 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
             out[key] = check_number(value, w, positive=True)
     for key in ANALYSIS_OPTIONAL:
         if key in d:
-            if key == "max_iterations":
+            if key == "adaptive":
+                if not isinstance(d[key], bool):
+                    fail(f"{where}.{key}", f"expected true or false, got {d[key]!r}")
+                if out["integrator"] not in ADAPTIVE_OPTIONAL:
+                    fail(f"{where}.{key}", f"applies to {' and '.join(ADAPTIVE_OPTIONAL)}; "
+                         f"{out['integrator']} chooses its steps itself (leave it out)")
+                out[key] = d[key]
+            elif key == "max_iterations":
                 if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < 1:
                     fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
                 out[key] = d[key]
@@ -148,20 +170,34 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
     return out
 
 
-def _check_output(o: Any, where: str, model: Model) -> Dict[str, Any]:
+def _check_component(d: Dict[str, Any], where: str, quantity: str, planar: bool) -> None:
+    """The component of a vector quantity; none for a planar angle, rate or torque."""
+    if planar and quantity in PLANAR_SCALARS:
+        if "component" in d:
+            fail(f"{where}.component", f"a planar {quantity} is a number; leave 'component' out")
+        return
+    if "component" not in d:
+        fail(where, "missing 'component'")
+    comps = (QUATERNION_COMPONENTS if quantity == "orientation"
+             else PLANAR_COMPONENTS if planar else COMPONENTS)
+    check_choice(d["component"], f"{where}.component", list(comps))
+
+
+def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
     if not isinstance(o, Mapping):
         fail(where, f"expected an output column (an object), got {o!r}")
+    planar = model.space == "planar"
     if "body" in o:
         d = check_keys(o, where, ("name", "body", "quantity", "component"),
-                       ("name", "body", "quantity", "component"))
+                       ("name", "body", "quantity"))
         if d["body"] not in model.body_names[1:]:
             fail(f"{where}.body", f"no moving body named {d['body']!r}")
-        check_choice(d["quantity"], f"{where}.quantity", BODY_QUANTITIES)
-        comps = QUATERNION_COMPONENTS if d["quantity"] == "orientation" else COMPONENTS
-        check_choice(d["component"], f"{where}.component", list(comps))
+        check_choice(d["quantity"], f"{where}.quantity",
+                     PLANAR_BODY_QUANTITIES if planar else BODY_QUANTITIES)
+        _check_component(d, where, d["quantity"], planar)
     elif "reaction" in o:
         d = check_keys(o, where, ("name", "reaction", "side", "axes", "quantity", "component"),
-                       ("name", "reaction", "quantity", "component"))
+                       ("name", "reaction", "quantity"))
         d.setdefault("side", "b")
         d.setdefault("axes", "global")
         name = d["reaction"]
@@ -171,13 +207,15 @@ def _check_output(o: Any, where: str, model: Model) -> Dict[str, Any]:
         check_choice(d["side"], f"{where}.side", ("a", "b"))
         check_choice(d["axes"], f"{where}.axes", ("global", "joint"))
         check_choice(d["quantity"], f"{where}.quantity", ("force", "torque"))
-        check_choice(d["component"], f"{where}.component", list(COMPONENTS))
+        _check_component(d, where, d["quantity"], planar)
     elif "state" in o:
         d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
-        fields = {"rsda": ("angle",), "engine_gas_force": ("theta", "half_turn")}
+        fields: Dict[str, Sequence[str]] = {"engine_gas_force": ("theta", "half_turn")}
+        if not planar:
+            fields["rsda"] = ("angle",)
         name = d["state"]
         if name not in model.element_names or model.element_type(name) not in fields:
-            fail(f"{where}.state", f"no stateful force (rsda, engine_gas_force) named {name!r}")
+            fail(f"{where}.state", f"no stateful force ({', '.join(fields)}) named {name!r}")
         check_choice(d["field"], f"{where}.field", fields[model.element_type(name)])
     else:
         d = check_keys(o, where, ("name", "quantity"), ("name", "quantity"))
@@ -207,11 +245,14 @@ def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
     if "body" in spec:
         history = result.body(spec["body"])
         values = getattr(history, spec["quantity"])
+        if values.ndim == 1:  # a planar angle or rate
+            return values
         comps = QUATERNION_COMPONENTS if spec["quantity"] == "orientation" else COMPONENTS
         return values[:, comps[spec["component"]]]
     if "reaction" in spec:
         r = result.reaction(spec["reaction"], spec.get("side", "b"), spec.get("axes", "global"))
-        return getattr(r, spec["quantity"])[:, COMPONENTS[spec["component"]]]
+        values = getattr(r, spec["quantity"])
+        return values if values.ndim == 1 else values[:, COMPONENTS[spec["component"]]]
     if "state" in spec:
         return result.state(spec["state"])[spec["field"]]
     return result[spec["quantity"]]
@@ -226,7 +267,9 @@ def from_dict(d: Any, where: str = "") -> Scene:
     if "odyn" in d and d["odyn"] != FORMAT_VERSION:
         fail(f"{prefix}odyn", f"unsupported scene format version {d['odyn']!r}; expected "
              f"{FORMAT_VERSION}")
-    model = Model()
+    space = check_choice(d.get("space", "spatial"), f"{prefix}space", SPACES)
+    sections = SPACE_SECTIONS[space]
+    model = new_model(space)
     bodies = d["bodies"]
     if not isinstance(bodies, list):
         fail(f"{prefix}bodies", f"expected a list of bodies, got {type(bodies).__name__}")
@@ -234,7 +277,7 @@ def from_dict(d: Any, where: str = "") -> Scene:
         if not isinstance(b, Mapping):
             _not_object(b, f"{prefix}bodies[{i}]")
         model._add_body(b, f"{prefix}bodies[{i}]")
-    for section, kinds in SECTIONS.items():
+    for section, kinds in sections.items():
         entries = d.get(section, [])
         if not isinstance(entries, list):
             fail(f"{prefix}{section}", f"expected a list, got {type(entries).__name__}")
@@ -247,9 +290,13 @@ def from_dict(d: Any, where: str = "") -> Scene:
             kind = e["type"]
             if not isinstance(kind, str) or kind not in kinds:
                 hint = ""
-                for other, other_kinds in SECTIONS.items():
+                for other, other_kinds in sections.items():
                     if kind in other_kinds:
                         hint = f" ('{kind}' belongs in '{other}')"
+                other_space = "spatial" if space == "planar" else "planar"
+                if not hint and kind in SPACE_SECTIONS[other_space][section]:
+                    hint = (f" ('{kind}' is a {other_space} {section[:-1]}; this scene's space "
+                            f"is {space})")
                 fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "
                      f"{', '.join(kinds)}")
             model._add(kind, {k: v for k, v in e.items() if k != "type"}, w)
@@ -302,9 +349,9 @@ def load(path: Union[str, os.PathLike]) -> Scene:
         raise SceneError(f"{path}: {message}") from None
 
 
-def save(scene: Union[Scene, Model], path: Union[str, os.PathLike]) -> None:
+def save(scene: Union[Scene, BaseModel], path: Union[str, os.PathLike]) -> None:
     """Writes a scene (or a model with default analysis settings) as JSON."""
-    if isinstance(scene, Model):
+    if isinstance(scene, BaseModel):
         scene = Scene(scene)
     text = json.dumps(scene.to_dict(), indent=2, allow_nan=False)
     with open(path, "w", encoding="utf-8") as f:

@@ -1,7 +1,8 @@
 #pragma once
-// What the two translation units of odyn._core share: the model type the bindings compile
-// (every spatial element of the library, the engine's gas force and forces written in Python),
-// and the bridge that lets a Python callable act as an element's function.
+// What the translation units of odyn._core share: the two model types the bindings compile
+// (every spatial element, every planar element, the engine's gas force in both spaces and
+// forces written in Python), and the bridge that lets a Python callable act as an element's
+// function.
 //
 // Runs release the GIL; a Python callable takes it back only for its own call.
 
@@ -24,14 +25,22 @@ namespace odyn::python {
 
 namespace py = pybind11;
 namespace sp = odyn::spatial;
+namespace pl = odyn::planar;
 
 /// Numbers a Python callable returned, checked for their count.
 void read_numbers(py::handle value, double* out, int count, const std::string& what);
 
 /// A body's frame as the Python callable sees it: a types.SimpleNamespace whose numpy arrays
-/// (position, rotation, linear_velocity, angular_velocity; read-only) view a buffer that is
-/// refreshed before every call. Reusing one object makes a call cost no allocation.
-class FrameView {
+/// (read-only) view a buffer that is refreshed before every call. Reusing one object makes a
+/// call cost no allocation.
+///   spatial: position (3), rotation (3 x 3), linear_velocity (3), angular_velocity (3, body)
+///   planar:  position (2), rotation (2 x 2), linear_velocity (2) as arrays; angle and
+///            angular_velocity as floats
+template <class Space>
+class FrameView;
+
+template <>
+class FrameView<Spatial> {
  public:
   FrameView();
   void load(const Spatial::Frame& frame);
@@ -45,8 +54,22 @@ class FrameView {
   py::object object_;
 };
 
+template <>
+class FrameView<Planar> {
+ public:
+  FrameView();
+  void load(const Planar::Frame& frame);
+  const py::object& object() const { return object_; }
+
+ private:
+  static constexpr int position = 0, rotation = 2, linear_velocity = 6, size = 8;
+  double* data_ = nullptr;
+  py::object object_;
+};
+
 /// A Python callable and the frame views it is handed. Calls take the GIL; the destructor too,
 /// so that an element may be dropped from any thread.
+template <class Space>
 class Callable {
  public:
   Callable(py::object function, int num_frames, std::string what);
@@ -55,53 +78,57 @@ class Callable {
   Callable& operator=(const Callable&) = delete;
 
   /// function(t, frame_0, ..., frame_{n-1}) with the frames loaded; the GIL must be held.
-  py::object call_with_frames(double t, const Spatial::Frame* const* frames);
+  py::object call_with_frames(double t, const typename Space::Frame* const* frames);
   /// function(a, b, c) for scalar arguments; the GIL must be held.
   py::object call_with_numbers(std::initializer_list<double> numbers);
   const std::string& what() const { return what_; }
 
  private:
   py::object function_;
-  std::vector<FrameView> views_;
+  std::vector<FrameView<Space>> views_;
   std::string what_;  // "point force 'push'": names the element in errors
 };
 
-/// A force and torque on N bodies (global force at each centre of mass, global torque) from a
-/// Python callable: function(t, body_0, ..., body_{N-1}) -> N x 6 numbers.
-template <int N>
+/// A force and torque on N bodies from a Python callable: function(t, body_0, ...,
+/// body_{N-1}) -> per body the global force at its centre of mass, then the global torque
+/// (spatial: 3 + 3 numbers; planar: 2 + 1).
+template <class SpaceT, int N>
 class UserForceT {
  public:
-  using Space = Spatial;
+  using Space = SpaceT;
   static constexpr int num_bodies = N;
+  static constexpr int width = Space::dim + Space::nw;  // numbers per body
 
   UserForceT(std::string name, const std::array<BodyId, N>& bodies,
-             std::shared_ptr<Callable> function)
+             std::shared_ptr<Callable<Space>> function)
       : name_(std::move(name)), bodies_(bodies), function_(std::move(function)) {}
 
   const std::string& name() const { return name_; }
   const std::array<BodyId, N>& bodies() const { return bodies_; }
 
   void evaluate(const ElementInput<Space, N>& in, ForceBlocks<Space, N>& out) const {
-    std::array<double, 6 * N> values;
+    std::array<double, width * N> values;
     {
       py::gil_scoped_acquire gil;
       const py::object result = function_->call_with_frames(in.t, in.frames.data());
-      read_numbers(result, values.data(), 6 * N, function_->what());
+      read_numbers(result, values.data(), width * N, function_->what());
     }
     for (int k = 0; k < N; ++k) {
-      const Eigen::Map<const Eigen::Vector3d> force(values.data() + 6 * k);
-      const Eigen::Map<const Eigen::Vector3d> torque(values.data() + 6 * k + 3);
-      out.force[k].template head<3>() = force;
-      out.force[k].template tail<3>() = in.body(k).torque_to_body(torque);
+      const Eigen::Map<const typename Space::Vector> force(values.data() + width * k);
+      const Eigen::Map<const typename Space::Angular> torque(values.data() + width * k +
+                                                             Space::dim);
+      out.force[k].template head<Space::dim>() = force;
+      out.force[k].template tail<Space::nw>() = in.body(k).torque_to_body(torque);
     }
   }
 
  private:
   std::string name_;
   std::array<BodyId, N> bodies_;
-  std::shared_ptr<Callable> function_;
+  std::shared_ptr<Callable<Space>> function_;
 };
-static_assert(StatelessForce<UserForceT<1>> && StatelessForce<UserForceT<2>>);
+static_assert(StatelessForce<UserForceT<Spatial, 1>> && StatelessForce<UserForceT<Spatial, 2>>);
+static_assert(StatelessForce<UserForceT<Planar, 1>> && StatelessForce<UserForceT<Planar, 2>>);
 
 /// Lets Python see Ctrl-C inside a long output interval: while an analysis runs (the GIL
 /// released), poll() takes the GIL every 50 ms of wall time to run Python's signal handlers.
@@ -129,9 +156,10 @@ class RunMonitor {
 
 /// A force element on the ground that applies nothing and polls the run monitor: every model
 /// of the bindings holds one, so that each force evaluation gives Ctrl-C a chance.
+template <class SpaceT>
 class SignalWatch {
  public:
-  using Space = Spatial;
+  using Space = SpaceT;
   static constexpr int num_bodies = 1;
   static inline const std::string reserved_name = "odyn: signal watch";
 
@@ -147,48 +175,91 @@ class SignalWatch {
   std::array<BodyId, 1> bodies_{ground};
   std::shared_ptr<RunMonitor> monitor_;
 };
-static_assert(StatelessForce<SignalWatch>);
+static_assert(StatelessForce<SignalWatch<Spatial>> && StatelessForce<SignalWatch<Planar>>);
 
 using EngineGasForce = engine::GasForce;
+using PlanarEngineGasForce = engine::planar::GasForce;
 
-/// The model type of the bindings. Its element list and element_type_names below go together.
-using Model =
-    sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
-              sp::Fixed, sp::Distance, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
-              sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<1>,
-              UserForceT<2>, SignalWatch>;
+/// The spatial model type of the bindings. Its element list and its element_type_names go
+/// together.
+using Model = sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal,
+                        sp::Cylindrical, sp::Fixed, sp::Distance, sp::RevoluteDriver,
+                        sp::TranslationalDriver, sp::Gravity, sp::PointForce, sp::PointTorque,
+                        sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<Spatial, 1>,
+                        UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
-inline constexpr std::array<const char*, Model::num_types> element_type_names = {
-    "revolute",
-    "translational",
-    "spherical",
-    "universal",
-    "cylindrical",
-    "fixed",
-    "distance",
-    "revolute_driver",
-    "translational_driver",
-    "gravity",
-    "point_force",
-    "point_torque",
-    "tsda",
-    "rsda",
-    "engine_gas_force",
-    "user_force",
-    "user_force",
-    "signal_watch"};
-static_assert(element_type_names.back() != nullptr, "a name for every element type");
+/// The planar model type of the bindings.
+using PlanarModel =
+    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::RevoluteDriver,
+              pl::TranslationalDriver, pl::Gravity, pl::PointForce, pl::PointTorque, pl::Tsda,
+              pl::Rsda, PlanarEngineGasForce, UserForceT<Planar, 1>, UserForceT<Planar, 2>,
+              SignalWatch<Planar>>;
 
-/// The model a Python odyn.Model holds, and whether an analysis is running on it (while the
-/// GIL is released, another thread must not change it).
-struct ModelBox {
-  ModelBox() { model.add(SignalWatch(monitor)); }
-  std::shared_ptr<RunMonitor> monitor = std::make_shared<RunMonitor>();
-  Model model;
-  bool running = false;
+/// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
+/// DefaultModel): a new element in the library fails this check until the bindings have it.
+template <class Target, class Catalogue>
+struct CoversCatalogue;
+template <class Target, class Body, class... Elements>
+struct CoversCatalogue<Target, odyn::Model<Body, Elements...>> {
+  static constexpr bool value = (Target::template holds<Elements> && ...);
+};
+static_assert(CoversCatalogue<Model, sp::DefaultModel>::value,
+              "the bindings' spatial model lacks an element of odyn::spatial::DefaultModel");
+static_assert(CoversCatalogue<PlanarModel, pl::DefaultModel>::value,
+              "the bindings' planar model lacks an element of odyn::planar::DefaultModel");
+
+/// Names of the element types, in the order of each model's element list.
+template <class M>
+struct ElementTypeNames;
+template <>
+struct ElementTypeNames<Model> {
+  static constexpr std::array<const char*, Model::num_types> value = {
+      "revolute",        "translational", "spherical",           "universal",
+      "cylindrical",     "fixed",         "distance",            "revolute_driver",
+      "translational_driver", "gravity",  "point_force",         "point_torque",
+      "tsda",            "rsda",          "engine_gas_force",    "user_force",
+      "user_force",      "signal_watch"};
+};
+template <>
+struct ElementTypeNames<PlanarModel> {
+  static constexpr std::array<const char*, PlanarModel::num_types> value = {
+      "revolute",    "translational",    "fixed",      "distance",   "revolute_driver",
+      "translational_driver", "gravity", "point_force", "point_torque", "tsda",
+      "rsda",        "engine_gas_force", "user_force", "user_force", "signal_watch"};
 };
 
-/// Registers the analyses (assembly, dynamics) on the module (analyses.cpp).
-void bind_analyses(py::module_& m);
+/// The model a Python odyn.Model (or odyn.PlanarModel) holds, and whether an analysis is
+/// running on it (while the GIL is released, another thread must not change it).
+template <class M>
+struct ModelBox {
+  using ModelType = M;
+  using Space = typename M::Space;
+  static constexpr const char* space_name = std::is_same_v<Space, Planar> ? "planar" : "spatial";
+  ModelBox() { model.add(SignalWatch<Space>(monitor)); }
+  std::shared_ptr<RunMonitor> monitor = std::make_shared<RunMonitor>();
+  M model;
+  bool running = false;
+};
+using SpatialBox = ModelBox<Model>;
+using PlanarBox = ModelBox<PlanarModel>;
+
+/// Adds bodies and elements of the planar model (planar.cpp).
+void add_planar_body(PlanarBox& box, const py::dict& parameters);
+void add_planar_element(PlanarBox& box, const std::string& type, const py::dict& parameters);
+
+/// Helpers shared by the model-building units (module.cpp, planar.cpp).
+double number(const py::dict& d, const char* key);
+std::string text(const py::dict& d, const char* key);
+bool is_callable(const py::dict& d, const char* key);
+Axes axes(const py::dict& d);
+Motion motion(const py::dict& d, const std::string& what);
+std::function<double(double, double, double)> scalar_function3(py::object f,
+                                                                const std::string& what);
+
+/// Registers the analyses (assembly, dynamics) of each model on the module
+/// (analyses_spatial.cpp, analyses_planar.cpp), and what is common to both (analyses.cpp).
+void bind_spatial_analyses(py::module_& m);
+void bind_planar_analyses(py::module_& m);
+void bind_integrators(py::module_& m);
 
 }  // namespace odyn::python

@@ -57,7 +57,7 @@ void read_numbers(py::handle value, double* out, int count, const std::string& w
                             std::string(py::repr(value)) + ")");
 }
 
-FrameView::FrameView() {
+FrameView<Spatial>::FrameView() {
   data_ = new double[size]();
   py::capsule owner(data_, [](void* p) { delete[] static_cast<double*>(p); });
   auto view = [&](std::vector<py::ssize_t> shape, int offset) {
@@ -71,7 +71,7 @@ FrameView::FrameView() {
       py::arg("angular_velocity") = view({3}, angular_velocity));
 }
 
-void FrameView::load(const Spatial::Frame& frame) {
+void FrameView<Spatial>::load(const Spatial::Frame& frame) {
   for (int i = 0; i < 3; ++i) {
     data_[position + i] = frame.position[i];
     for (int j = 0; j < 3; ++j) data_[rotation + 3 * i + j] = frame.rotation(i, j);  // by rows
@@ -80,18 +80,53 @@ void FrameView::load(const Spatial::Frame& frame) {
   }
 }
 
-Callable::Callable(py::object function, int num_frames, std::string what)
+FrameView<Planar>::FrameView() {
+  data_ = new double[size]();
+  py::capsule owner(data_, [](void* p) { delete[] static_cast<double*>(p); });
+  auto view = [&](std::vector<py::ssize_t> shape, int offset) {
+    py::array_t<double> array(shape, data_ + offset, owner);
+    array.attr("flags").attr("writeable") = false;
+    return array;
+  };
+  object_ = py::module_::import("types").attr("SimpleNamespace")(
+      py::arg("position") = view({2}, position), py::arg("angle") = 0.0,
+      py::arg("rotation") = view({2, 2}, rotation),
+      py::arg("linear_velocity") = view({2}, linear_velocity),
+      py::arg("angular_velocity") = 0.0);
+}
+
+void FrameView<Planar>::load(const Planar::Frame& frame) {
+  for (int i = 0; i < 2; ++i) {
+    data_[position + i] = frame.position[i];
+    for (int j = 0; j < 2; ++j) data_[rotation + 2 * i + j] = frame.rotation(i, j);  // by rows
+    data_[linear_velocity + i] = frame.linear_velocity[i];
+  }
+  // Scalars are attributes of the namespace (Python floats: the cheapest for user code).
+  const auto set = [&](const char* name, double value) {
+    const py::object number = py::reinterpret_steal<py::object>(PyFloat_FromDouble(value));
+    if (!number || PyObject_SetAttrString(object_.ptr(), name, number.ptr()) != 0)
+      throw py::error_already_set();
+  };
+  set("angle", frame.angle);
+  set("angular_velocity", frame.omega());
+}
+
+template <class Space>
+Callable<Space>::Callable(py::object function, int num_frames, std::string what)
     : function_(std::move(function)),
       views_(static_cast<std::size_t>(num_frames)),
       what_(std::move(what)) {}
 
-Callable::~Callable() {
+template <class Space>
+Callable<Space>::~Callable() {
   py::gil_scoped_acquire gil;
   function_ = py::object();
   views_.clear();
 }
 
-py::object Callable::call_with_frames(double t, const Spatial::Frame* const* frames) {
+template <class Space>
+py::object Callable<Space>::call_with_frames(double t,
+                                             const typename Space::Frame* const* frames) {
   // Vectorcall with the argument slots on the stack: no tuple is built.
   std::array<PyObject*, 4> args{};  // slot 0 is scratch (PY_VECTORCALL_ARGUMENTS_OFFSET)
   py::object time = py::reinterpret_steal<py::object>(PyFloat_FromDouble(t));
@@ -107,7 +142,8 @@ py::object Callable::call_with_frames(double t, const Spatial::Frame* const* fra
   return py::reinterpret_steal<py::object>(result);
 }
 
-py::object Callable::call_with_numbers(std::initializer_list<double> numbers) {
+template <class Space>
+py::object Callable<Space>::call_with_numbers(std::initializer_list<double> numbers) {
   std::array<PyObject*, 4> args{};
   std::array<py::object, 3> owned;
   std::size_t n = 0;
@@ -122,15 +158,11 @@ py::object Callable::call_with_numbers(std::initializer_list<double> numbers) {
   return py::reinterpret_steal<py::object>(result);
 }
 
-namespace {
+template class Callable<Spatial>;
+template class Callable<Planar>;
 
-// --- Parameters from the Python layer's dict -------------------------------------------------
+// --- Parameters from the Python layer's dict (shared with planar.cpp) ------------------------
 
-using Eigen::Vector3d;
-
-Vector3d vec3(const py::dict& d, const char* key) {
-  return d[key].cast<Vector3d>();
-}
 double number(const py::dict& d, const char* key) {
   return d[key].cast<double>();
 }
@@ -140,28 +172,15 @@ std::string text(const py::dict& d, const char* key) {
 bool is_callable(const py::dict& d, const char* key) {
   return d.contains(key) && PyCallable_Check(d[key].ptr());
 }
-std::string describe(const std::string& type, const std::string& name) {
-  return type + " '" + name + "'";
-}
-
-sp::JointFrame joint_frame(const py::dict& d, const char* key) {
-  const py::dict frame = d[key].cast<py::dict>();
-  sp::JointFrame out;
-  out.point = vec3(frame, "point");
-  out.axis = vec3(frame, "axis");
-  if (frame.contains("reference") && !frame["reference"].is_none())
-    out.reference = vec3(frame, "reference");
-  return out;
-}
-
 Axes axes(const py::dict& d) {
   return d.contains("axes") && text(d, "axes") == "body" ? Axes::body : Axes::global;
 }
 
+namespace {
 /// A scalar function of one or three numbers from a Python callable.
 template <class... Args>
 std::function<double(Args...)> scalar_function(py::object f, const std::string& what) {
-  auto callable = std::make_shared<Callable>(std::move(f), 0, what);
+  auto callable = std::make_shared<Callable<Spatial>>(std::move(f), 0, what);
   return [callable](Args... args) {
     py::gil_scoped_acquire gil;
     double value = 0.0;
@@ -169,6 +188,12 @@ std::function<double(Args...)> scalar_function(py::object f, const std::string& 
                  callable->what());
     return value;
   };
+}
+}  // namespace
+
+std::function<double(double, double, double)> scalar_function3(py::object f,
+                                                                const std::string& what) {
+  return scalar_function<double, double, double>(std::move(f), what);
 }
 
 Motion motion(const py::dict& d, const std::string& what) {
@@ -188,10 +213,33 @@ Motion motion(const py::dict& d, const std::string& what) {
   throw ModelError(what, "unknown motion type '" + type + "'");
 }
 
+namespace {
+
+// --- Parameters from the Python layer's dict -------------------------------------------------
+
+using Eigen::Vector3d;
+
+Vector3d vec3(const py::dict& d, const char* key) {
+  return d[key].cast<Vector3d>();
+}
+std::string describe(const std::string& type, const std::string& name) {
+  return type + " '" + name + "'";
+}
+
+sp::JointFrame joint_frame(const py::dict& d, const char* key) {
+  const py::dict frame = d[key].cast<py::dict>();
+  sp::JointFrame out;
+  out.point = vec3(frame, "point");
+  out.axis = vec3(frame, "axis");
+  if (frame.contains("reference") && !frame["reference"].is_none())
+    out.reference = vec3(frame, "reference");
+  return out;
+}
+
 template <class Vector>
 std::function<Vector(double, const Spatial::Frame&)> frame_function(py::object f,
                                                                     const std::string& what) {
-  auto callable = std::make_shared<Callable>(std::move(f), 1, what);
+  auto callable = std::make_shared<Callable<Spatial>>(std::move(f), 1, what);
   return [callable](double t, const Spatial::Frame& frame) {
     const Spatial::Frame* frames[1] = {&frame};
     Vector value;
@@ -201,7 +249,7 @@ std::function<Vector(double, const Spatial::Frame&)> frame_function(py::object f
   };
 }
 
-void add_element(ModelBox& box, const std::string& type, const py::dict& d) {
+void add_element(SpatialBox& box, const std::string& type, const py::dict& d) {
   if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
   Model& model = box.model;
   const std::string name = text(d, "name");
@@ -248,7 +296,7 @@ void add_element(ModelBox& box, const std::string& type, const py::dict& d) {
     sp::Tsda::Parameters p{
         number(d, "stiffness"), number(d, "damping"), number(d, "free_length"), {}};
     if (is_callable(d, "actuator"))
-      p.actuator = scalar_function<double, double, double>(d["actuator"], what + " actuator");
+      p.actuator = scalar_function3(d["actuator"], what + " actuator");
     return void(model.add(
         sp::Tsda(name, body("body_a"), vec3(d, "point_a"), body("body_b"), vec3(d, "point_b"), p)));
   }
@@ -256,7 +304,7 @@ void add_element(ModelBox& box, const std::string& type, const py::dict& d) {
     sp::Rsda::Parameters p{
         number(d, "stiffness"), number(d, "damping"), number(d, "free_angle"), {}};
     if (is_callable(d, "actuator"))
-      p.actuator = scalar_function<double, double, double>(d["actuator"], what + " actuator");
+      p.actuator = scalar_function3(d["actuator"], what + " actuator");
     return void(model.add(sp::Rsda(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
                                    joint_frame(d, "on_b"), p)));
   }
@@ -268,18 +316,19 @@ void add_element(ModelBox& box, const std::string& type, const py::dict& d) {
   }
   if (type == "user_force") {
     const auto names = d["bodies"].cast<std::vector<std::string>>();
-    auto callable = std::make_shared<Callable>(d["function"], static_cast<int>(names.size()), what);
+    auto callable =
+        std::make_shared<Callable<Spatial>>(d["function"], static_cast<int>(names.size()), what);
     if (names.size() == 1)
-      return void(model.add(UserForceT<1>(name, {model.body(names[0])}, callable)));
+      return void(model.add(UserForceT<Spatial, 1>(name, {model.body(names[0])}, callable)));
     if (names.size() == 2)
       return void(
-          model.add(UserForceT<2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
+          model.add(UserForceT<Spatial, 2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
     throw ModelError(name, "a user force acts on one or two bodies");
   }
   throw ModelError(name, "unknown element type '" + type + "'");
 }
 
-void add_body(ModelBox& box, const py::dict& d) {
+void add_body(SpatialBox& box, const py::dict& d) {
   if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
   sp::Body body;
   body.name = text(d, "name");
@@ -293,6 +342,31 @@ void add_body(ModelBox& box, const py::dict& d) {
   if (d.contains("velocity_given") && !d["velocity_given"].is_none())
     body.velocity_given = d["velocity_given"].cast<std::array<bool, 6>>();
   box.model.add_body(std::move(body));
+}
+
+template <class Box, class AddBody, class AddElement>
+void bind_model(py::module_& m, const char* name, const char* doc, AddBody add_body_function,
+                AddElement add_element_function) {
+  py::class_<Box>(m, name, doc)
+      .def(py::init<>())
+      .def("add_body", add_body_function, py::arg("parameters"))
+      .def("add_element", add_element_function, py::arg("type"), py::arg("parameters"))
+      .def_property_readonly("space", [](const Box&) { return std::string(Box::space_name); })
+      .def_property_readonly("num_bodies", [](const Box& b) { return b.model.num_bodies(); })
+      .def_property_readonly("num_equations",
+                             [](const Box& b) { return b.model.num_equations(); })
+      .def("body_index",
+           [](const Box& b, const std::string& body) { return b.model.body(body).index; })
+      .def("element_type", [](const Box& b, const std::string& element) {
+        using M = typename Box::ModelType;
+        return std::string(ElementTypeNames<M>::value[b.model.locate(element).type]);
+      });
+}
+
+template <class M>
+py::object type_names() {
+  const auto& names = ElementTypeNames<M>::value;
+  return py::cast(std::vector<std::string>(names.begin(), names.end()));
 }
 
 }  // namespace
@@ -321,20 +395,13 @@ PYBIND11_MODULE(_core, m) {
     }
   });
 
-  py::class_<ModelBox>(m, "Model", "The C++ model (odyn.Model wraps it).")
-      .def(py::init<>())
-      .def("add_body", &add_body, py::arg("parameters"))
-      .def("add_element", &add_element, py::arg("type"), py::arg("parameters"))
-      .def_property_readonly("num_bodies", [](const ModelBox& b) { return b.model.num_bodies(); })
-      .def_property_readonly("num_equations",
-                             [](const ModelBox& b) { return b.model.num_equations(); })
-      .def("body_index",
-           [](const ModelBox& b, const std::string& name) { return b.model.body(name).index; })
-      .def("element_type", [](const ModelBox& b, const std::string& name) {
-        return std::string(element_type_names[b.model.locate(name).type]);
-      });
-
-  m.attr("element_types") =
-      py::cast(std::vector<std::string>(element_type_names.begin(), element_type_names.end()));
-  bind_analyses(m);
+  bind_model<SpatialBox>(m, "Model", "The C++ spatial model (odyn.Model wraps it).", &add_body,
+                         &add_element);
+  bind_model<PlanarBox>(m, "PlanarModel", "The C++ planar model (odyn.PlanarModel wraps it).",
+                        &add_planar_body, &add_planar_element);
+  m.attr("element_types") = type_names<Model>();
+  m.attr("planar_element_types") = type_names<PlanarModel>();
+  bind_integrators(m);
+  bind_spatial_analyses(m);
+  bind_planar_analyses(m);
 }

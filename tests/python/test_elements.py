@@ -330,18 +330,27 @@ def test_python_callable_errors_reach_the_caller_with_partial_results():
 
 
 def test_redundant_and_unassemblable_models_name_the_joints():
+    # A hinge and a weld on the same body: consistent, but the weld repeats the hinge's five
+    # equations. The analyses run with the minimum-norm multipliers and name the equations.
     m = odyn.Model()
     m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
     m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
                    on_b=odyn.frame())
     m.add_fixed(name="weld", body_a="ground", on_a=odyn.frame([0, 0, 1], Z), body_b="b",
                 on_b=odyn.frame())
-    with pytest.raises(odyn.ModelError, match=r"weld \(equation \d\): constraint equations are "
-                       "redundant"):
-        odyn.assemble(m)
-    with pytest.raises(odyn.ModelError, match="redundant") as info:
-        odyn.simulate(m, t_end=0.1)
-    assert len(info.value.result) == 0  # nothing was computed
+    m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+    with pytest.warns(odyn.RedundantConstraintsWarning,
+                      match=r"\(equation \d\): constraint equations are redundant"):
+        a = odyn.assemble(m)
+    assert len(a.redundant_equations) == 5
+    assert {e["joint"] for e in a.redundant_equations} <= {"hinge", "weld"}
+    with pytest.warns(odyn.RedundantConstraintsWarning, match="minimum-norm"):
+        r = odyn.simulate(m, t_end=0.1, step=1e-3, output_interval=0.05)
+    assert r.redundant_equations == a.redundant_equations
+    np.testing.assert_allclose(r.body("b").position[-1], [0, 0, 1], atol=1e-12)
+    # Together the two joints carry the weight (how they share it is the minimum-norm choice).
+    total = r.reaction("hinge").force + r.reaction("weld").force
+    np.testing.assert_allclose(total[-1], [0, 0, G], atol=1e-8)
     m = odyn.Model()
     m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], position=[0, 0, 1])
     m.add_distance(name="rod 1", body_a="ground", point_a=[0, 0, 0], body_b="b",

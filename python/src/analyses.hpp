@@ -1,0 +1,364 @@
+#pragma once
+// odyn._core: assembly and dynamic analysis, for either model of the bindings (instantiated in
+// analyses.cpp and analyses_planar.cpp). A run releases the GIL; at every output time it
+// records the state, the energies, the residuals, every constraint's reactions and every
+// stateful force's state, then briefly takes the GIL to let Python handle signals (Ctrl-C) and
+// report progress. A run that stops early keeps what it recorded.
+
+#include <Python.h>
+
+#include <chrono>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+
+namespace odyn::python {
+
+namespace analysis {
+
+template <class T>
+T get(const py::dict& d, const char* key, T fallback) {
+  return d.contains(key) && !d[key].is_none() ? d[key].cast<T>() : fallback;
+}
+
+inline AssemblySettings assembly_settings(const py::dict& d) {
+  AssemblySettings s;
+  s.tolerance = get(d, "assembly_tolerance", s.tolerance);
+  s.max_iterations = get(d, "assembly_max_iterations", s.max_iterations);
+  return s;
+}
+
+inline DynamicsSettings dynamics_settings(const py::dict& d) {
+  DynamicsSettings s;
+  s.step = get(d, "step", s.step);
+  s.t_end = get(d, "t_end", s.t_end);
+  s.output_interval = get(d, "output_interval", s.output_interval);
+  s.integrator = get(d, "integrator", s.integrator);
+  s.rtol = get(d, "rtol", s.rtol);
+  s.atol = get(d, "atol", s.atol);
+  s.max_step = get(d, "max_step", s.max_step);
+  auto& ga = s.generalized_alpha;
+  ga.rho_inf = get(d, "rho_inf", ga.rho_inf);
+  ga.adaptive = get(d, "adaptive", ga.adaptive);
+  ga.newton_rtol = get(d, "newton_rtol", ga.newton_rtol);
+  ga.newton_atol = get(d, "newton_atol", ga.newton_atol);
+  ga.constraint_tolerance = get(d, "constraint_tolerance", ga.constraint_tolerance);
+  ga.max_iterations = get(d, "max_iterations", ga.max_iterations);
+  auto& dp = s.dormand_prince;
+  dp.projection_tolerance = get(d, "projection_tolerance", dp.projection_tolerance);
+  s.assembly = assembly_settings(d);
+  return s;
+}
+
+/// The discrete state a stateful force exposes to Python: field names and values.
+template <class E>
+std::vector<std::string> state_fields() {
+  if constexpr (std::is_same_v<E, sp::Rsda>)
+    return {"angle"};
+  else if constexpr (std::is_same_v<E, EngineGasForce> || std::is_same_v<E, PlanarEngineGasForce>)
+    return {"theta", "half_turn"};
+  else
+    return {};
+}
+template <class State>
+void write_state(const State& state, std::vector<double>& out) {
+  if constexpr (std::is_same_v<State, sp::Rsda::State>) {
+    out.push_back(state.angle);
+  } else if constexpr (std::is_same_v<State, EngineGasForce::State> ||
+                       std::is_same_v<State, PlanarEngineGasForce::State>) {
+    out.push_back(state.theta);
+    out.push_back(static_cast<double>(state.half_turn));
+  }
+}
+
+inline py::array_t<double> to_array(const std::vector<double>& data, py::ssize_t rows,
+                             std::vector<py::ssize_t> shape_of_row = {}) {
+  std::vector<py::ssize_t> shape{rows};
+  shape.insert(shape.end(), shape_of_row.begin(), shape_of_row.end());
+  py::array_t<double> array(shape);
+  std::copy(data.begin(), data.end(), array.mutable_data());
+  return array;
+}
+
+/// One row per output time.
+template <class Model>
+class Recorder {
+ public:
+  using Workspace = odyn::Workspace<Model>;
+  using Space = typename Model::Space;
+  static constexpr int wrench = Space::dim + Space::nw;  // force and torque of a reaction
+
+  explicit Recorder(const Model& model) : model_(model) {
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        if constexpr (Constraint<E>) {
+          constraints_.push_back(
+              {pool[i].name(), model.row(Handle<E>{i}), static_cast<int>(E::num_equations)});
+        } else if constexpr (StatefulForce<E>) {
+          if (!state_fields<E>().empty()) stateful_.push_back({pool[i].name(), state_fields<E>()});
+        }
+      }
+    });
+    for (const auto& s : stateful_) state_width_ += static_cast<int>(s.fields.size());
+  }
+
+  void record(const Workspace& ws) {
+    ++rows_;
+    t_.push_back(ws.t);
+    q_.insert(q_.end(), ws.q.begin(), ws.q.end());
+    v_.insert(v_.end(), ws.v.begin(), ws.v.end());
+    vdot_.insert(vdot_.end(), ws.vdot.begin(), ws.vdot.end());
+    lambda_.insert(lambda_.end(), ws.lambda.begin(), ws.lambda.end());
+    const auto [phi_norm, phid_norm] = constraint_residuals(model_, ws);
+    phi_norm_.push_back(phi_norm);
+    phid_norm_.push_back(phid_norm);
+    kinetic_.push_back(kinetic_energy(model_, ws));
+    potential_.push_back(potential_energy(model_, ws));
+    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        if constexpr (Constraint<E>) {
+          for (const Side side : {Side::a, Side::b})
+            for (const ReactionAxes axes : {ReactionAxes::global, ReactionAxes::joint}) {
+              const auto w = reaction(model_, ws, Handle<E>{i}, side, axes);
+              reactions_.insert(reactions_.end(), w.force.begin(), w.force.end());
+              reactions_.insert(reactions_.end(), w.torque.begin(), w.torque.end());
+            }
+        } else if constexpr (StatefulForce<E>) {
+          write_state(std::get<type>(ws.states)[i], states_);
+        }
+      }
+    });
+  }
+
+  long rows() const { return rows_; }
+
+  py::dict to_python() const {
+    py::dict out;
+    out["t"] = to_array(t_, rows_);
+    out["q"] = to_array(q_, rows_, {model_.num_coordinates()});
+    out["v"] = to_array(v_, rows_, {model_.num_velocities()});
+    out["vdot"] = to_array(vdot_, rows_, {model_.num_velocities()});
+    out["lambda"] = to_array(lambda_, rows_, {model_.num_equations()});
+    out["phi_norm"] = to_array(phi_norm_, rows_);
+    out["phid_norm"] = to_array(phid_norm_, rows_);
+    out["kinetic_energy"] = to_array(kinetic_, rows_);
+    out["potential_energy"] = to_array(potential_, rows_);
+    py::list bodies;
+    for (int b = 1; b <= model_.num_bodies(); ++b) bodies.append(model_.body(BodyId{b}).name);
+    out["bodies"] = bodies;
+    out["space"] = std::is_same_v<Space, Planar> ? "planar" : "spatial";
+    // Reactions of each constraint: (outputs, side a/b, global/joint axes, force + torque).
+    const std::size_t num_constraints = constraints_.size();
+    py::dict reactions, rows;
+    for (std::size_t c = 0; c < num_constraints; ++c) {
+      py::array_t<double> r(
+          {static_cast<py::ssize_t>(rows_), py::ssize_t{2}, py::ssize_t{2}, py::ssize_t{wrench}});
+      double* target = r.mutable_data();
+      constexpr int row = 4 * wrench;
+      for (long k = 0; k < rows_; ++k)
+        std::copy_n(reactions_.data() + (static_cast<std::size_t>(k) * num_constraints + c) * row,
+                    row, target + k * row);
+      reactions[py::str(constraints_[c].name)] = r;
+      rows[py::str(constraints_[c].name)] =
+          py::make_tuple(constraints_[c].row, constraints_[c].size);
+    }
+    out["reactions"] = reactions;
+    out["constraint_rows"] = rows;
+    py::dict states;
+    int column = 0;
+    for (const auto& s : stateful_) {
+      py::dict fields;
+      for (const auto& field : s.fields) {
+        py::array_t<double> values(static_cast<py::ssize_t>(rows_));
+        for (long k = 0; k < rows_; ++k)
+          values.mutable_data()[k] = states_[static_cast<std::size_t>(k * state_width_ + column)];
+        fields[py::str(field)] = values;
+        ++column;
+      }
+      states[py::str(s.name)] = fields;
+    }
+    out["states"] = states;
+    return out;
+  }
+
+ private:
+  struct ConstraintInfo {
+    std::string name;
+    int row, size;
+  };
+  struct StateInfo {
+    std::string name;
+    std::vector<std::string> fields;
+  };
+  const Model& model_;
+  std::vector<ConstraintInfo> constraints_;
+  std::vector<StateInfo> stateful_;
+  int state_width_ = 0;
+  long rows_ = 0;
+  std::vector<double> t_, q_, v_, vdot_, lambda_, phi_norm_, phid_norm_, kinetic_, potential_;
+  std::vector<double> reactions_, states_;
+};
+
+inline py::dict assembly_report(const AssemblyReport& r) {
+  py::dict d;
+  d["iterations"] = r.iterations;
+  d["position_residual"] = r.position_residual;
+  d["velocity_residual"] = r.velocity_residual;
+  d["kept_velocity_components"] = r.kept_velocity_components;
+  d["adjusted_velocity_components"] = r.adjusted_velocity_components;
+  return d;
+}
+
+/// Constraint equations that repeat others (the run uses minimum-norm multipliers for them).
+inline py::list redundant_list(const std::vector<RedundantEquation>& equations) {
+  py::list out;
+  for (const auto& e : equations) {
+    py::dict d;
+    d["joint"] = e.joint;
+    d["equation"] = e.equation;
+    d["row"] = e.row;
+    out.append(d);
+  }
+  return out;
+}
+
+inline py::dict run_summary(const RunSummary& s) {
+  py::dict d;
+  const auto& st = s.statistics;
+  d["steps"] = st.steps;
+  d["newton_iterations"] = st.newton_iterations;
+  d["jacobian_evaluations"] = st.jacobian_evaluations;
+  d["factorizations"] = st.factorizations;
+  d["residual_evaluations"] = st.residual_evaluations;
+  d["rejected_steps"] = st.rejected_steps;
+  d["restarts"] = st.restarts;
+  d["events"] = st.events;
+  d["max_error_estimate"] = st.max_error_estimate;
+  d["outputs"] = s.outputs;
+  d["wall_seconds"] = s.wall_seconds;
+  d["max_position_residual"] = s.max_position_residual;
+  d["max_velocity_residual"] = s.max_velocity_residual;
+  py::dict assembly = assembly_report(s.assembly);
+  assembly["redundant_equations"] = redundant_list(s.redundant_equations);
+  d["assembly"] = assembly;
+  return d;
+}
+
+/// The Python exception object for an exception caught during a run (the GIL held).
+inline py::object python_exception(const std::exception_ptr& error) {
+  const py::module_ core = py::module_::import("odyn._core");
+  try {
+    std::rethrow_exception(error);
+  } catch (py::error_already_set& e) {
+    return e.value();
+  } catch (const ModelError& e) {
+    return core.attr("ModelError")(e.what());
+  } catch (const AssemblyError& e) {
+    return core.attr("AssemblyError")(e.what());
+  } catch (const SolverError& e) {
+    return core.attr("SolverError")(e.what());
+  } catch (const Error& e) {
+    return core.attr("Error")(e.what());
+  } catch (const py::builtin_exception& e) {
+    e.set_error();
+    return py::error_already_set().value();
+  } catch (const std::exception& e) {
+    return py::module_::import("builtins").attr("RuntimeError")(e.what());
+  }
+}
+
+/// Marks a model busy for the lifetime of an analysis.
+template <class Box>
+class Running {
+ public:
+  explicit Running(Box& box) : box_(box) {
+    if (box.running) throw ModelError("model", "an analysis is already running on this model");
+    box.running = true;
+  }
+  ~Running() {
+    box_.monitor->stop();
+    box_.running = false;
+  }
+  Running(const Running&) = delete;
+  Running& operator=(const Running&) = delete;
+
+ private:
+  Box& box_;
+};
+
+template <class Box>
+py::dict assemble(Box& box, const py::dict& settings) {
+  using M = typename Box::ModelType;
+  Running<Box> running(box);  // (the settings are read before the GIL is released)
+  odyn::Workspace<M> ws(box.model);
+  Recorder<M> recorder(box.model);
+  const AssemblySettings s = assembly_settings(settings);
+  AssemblyReport report;
+  std::vector<RedundantEquation> redundant;
+  {
+    py::gil_scoped_release release;
+    box.monitor->start();
+    report = odyn::assemble(box.model, ws, s);
+    redundant = odyn::redundant_equations(box.model, ws);
+    recorder.record(ws);
+  }
+  py::dict out = recorder.to_python();
+  py::dict assembly = assembly_report(report);
+  assembly["redundant_equations"] = redundant_list(redundant);
+  out["assembly"] = assembly;
+  return out;
+}
+
+template <class Box>
+py::dict simulate(Box& box, const py::dict& settings, py::object progress,
+                  double progress_interval) {
+  using M = typename Box::ModelType;
+  const DynamicsSettings s = dynamics_settings(settings);
+  Running<Box> running(box);
+  odyn::Workspace<M> ws(box.model);
+  Recorder<M> recorder(box.model);
+  RunSummary summary;
+  std::exception_ptr error;
+  {
+    py::gil_scoped_release release;
+    box.monitor->start();
+    using Clock = std::chrono::steady_clock;
+    auto last_report = Clock::now();
+    try {
+      summary = odyn::simulate(box.model, ws, s, [&](const odyn::Workspace<M>& state) {
+        recorder.record(state);
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C, say
+        if (!progress.is_none() &&
+            std::chrono::duration<double>(Clock::now() - last_report).count() >=
+                progress_interval) {
+          progress(state.t);
+          last_report = Clock::now();
+        }
+      });
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }
+  py::dict out = recorder.to_python();
+  out["summary"] = error ? py::object(py::none()) : py::object(run_summary(summary));
+  out["error"] = error ? python_exception(error) : py::object(py::none());
+  return out;
+}
+
+/// Registers assemble and simulate for one model type (pybind11 overloads by the model).
+template <class Box>
+void bind(py::module_& m) {
+  m.def("assemble", &assemble<Box>, py::arg("model"), py::arg("settings"),
+        "Assembles the model; returns its consistent initial state as one output row.");
+  m.def("simulate", &simulate<Box>, py::arg("model"), py::arg("settings"),
+        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
+        "Runs a dynamic analysis; returns the recorded outputs, the summary (None if the run "
+        "stopped early) and the exception that stopped it (None if it finished).");
+}
+
+}  // namespace analysis
+
+}  // namespace odyn::python
