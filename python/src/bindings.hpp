@@ -214,19 +214,23 @@ struct ElementTypeNames;
 template <>
 struct ElementTypeNames<Model> {
   static constexpr std::array<const char*, Model::num_types> value = {
-      "revolute",        "translational", "spherical",           "universal",
-      "cylindrical",     "fixed",         "distance",            "revolute_driver",
-      "translational_driver", "gravity",  "point_force",         "point_torque",
-      "tsda",            "rsda",          "engine_gas_force",    "user_force",
-      "user_force",      "signal_watch"};
+      "revolute",         "translational",   "spherical",       "universal",
+      "cylindrical",      "fixed",           "distance",        "revolute_driver",
+      "translational_driver",                "gravity",         "point_force",
+      "point_torque",     "tsda",            "rsda",            "engine_gas_force",
+      "user_force",       "user_force",      "signal_watch"};
 };
 template <>
 struct ElementTypeNames<PlanarModel> {
   static constexpr std::array<const char*, PlanarModel::num_types> value = {
-      "revolute",    "translational",    "fixed",      "distance",   "revolute_driver",
-      "translational_driver", "gravity", "point_force", "point_torque", "tsda",
-      "rsda",        "engine_gas_force", "user_force", "user_force", "signal_watch"};
+      "revolute",         "translational",   "fixed",           "distance",
+      "revolute_driver",  "translational_driver",               "gravity",
+      "point_force",      "point_torque",    "tsda",            "rsda",
+      "engine_gas_force", "user_force",      "user_force",      "signal_watch"};
 };
+static_assert(ElementTypeNames<Model>::value.back() != nullptr &&
+                  ElementTypeNames<PlanarModel>::value.back() != nullptr,
+              "a name for every element type");
 
 /// The model a Python odyn.Model (or odyn.PlanarModel) holds, and whether an analysis is
 /// running on it (while the GIL is released, another thread must not change it).
