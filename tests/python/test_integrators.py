@@ -65,12 +65,7 @@ def test_every_integrator_solves_the_pendulum_with_error_control(name, exact_ang
 
 
 @pytest.mark.parametrize("name", list(odyn.integrators()))
-def test_outputs_land_on_the_output_times(name, request):
-    if name == "dopri5":  # dense output: see the reason
-        request.applymarker(pytest.mark.xfail(reason=(
-            "analysis/dynamics.hpp advance_with_dense_output records an output that falls on "
-            "the end of a step after interpolated ones without restore_trial(): the row "
-            "repeats the last interpolated state and time"), strict=False))
+def test_outputs_land_on_the_output_times(name):
     r = odyn.simulate(pendulum(), t_end=0.1, output_interval=0.01, integrator=name,
                       rtol=1e-8, atol=1e-8)
     np.testing.assert_allclose(r.t, np.linspace(0.0, 0.1, 11), rtol=0, atol=1e-14)

@@ -61,7 +61,12 @@ class DormandPrince {
     size_ = nq_total_ + nv_total_;
     y_n_ = Eigen::VectorXd::Zero(size_);
     y_new_ = y_n_;
+    y_trial_ = y_n_;
+    y_dense_ = y_n_;
     stage_ = y_n_;
+    k_new_ = y_n_;
+    vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
+    lambda_trial_ = Eigen::VectorXd::Zero(m_);
     for (auto& k : k_) k = Eigen::VectorXd::Zero(size_);
     rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
     velocity_residual_ = Eigen::VectorXd::Zero(m_);
@@ -119,7 +124,44 @@ class DormandPrince {
       if (e[i] != 0.0) stage_.noalias() += (h * e[i]) * k_[i];
     error_ = weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
     if (!std::isfinite(error_)) return false;
-    return project(t_n_ + h);
+    if (!project(t_n_ + h, y_new_)) return false;
+    // The trial state, kept for restore_trial() and, with k at it, for the dense output.
+    y_trial_ << ws_.q, ws_.v;
+    vdot_trial_ = ws_.vdot;
+    lambda_trial_ = ws_.lambda;
+    derivative_at_workspace(k_new_);
+    return true;
+  }
+
+  /// The state at t within the last attempted step (t_n <= t <= t_n + h), from the continuous
+  /// extension of order 4 (Shampine 1986; Hairer, Norsett & Wanner, Sect. II.6), projected onto
+  /// the constraints, with v' and lambda there: the workspace holds it as after an attempt.
+  bool interpolate(double t) {
+    dense_state(t);
+    return project(t, y_dense_, true);
+  }
+
+  /// The interpolated positions and velocities at t and the frames from them, unprojected.
+  void interpolate_frames(double t) {
+    dense_state(t);
+    ws_.t = t;
+    ws_.q = y_dense_.head(nq_total_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
+    ws_.v = y_dense_.tail(nv_total_);
+    update_frames(model_, ws_);
+  }
+
+  /// Puts the last attempt's trial state back into the workspace (after interpolate()).
+  void restore_trial() {
+    ws_.t = t_n_ + h_;
+    ws_.q = y_trial_.head(nq_total_);
+    ws_.v = y_trial_.tail(nv_total_);
+    ws_.vdot = vdot_trial_;
+    ws_.lambda = lambda_trial_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
   }
 
   /// Local error of the last attempt in units of the tolerance (accept when <= 1).
@@ -149,8 +191,8 @@ class DormandPrince {
   /// Makes the trial state of the last attempt the committed one (no step-size change).
   void commit() {
     t_n_ += h_;
-    y_n_ << ws_.q, ws_.v;
-    derivative_at_workspace(k_[0]);
+    y_n_ = y_trial_;
+    k_[0] = k_new_;
     vdot_n_ = ws_.vdot;
     lambda_n_ = ws_.lambda;
     advance_states(model_, ws_);
@@ -230,18 +272,38 @@ class DormandPrince {
     return solver_.factorize(model_, ws_, IterationFactors{});
   }
 
-  /// Moves y_new_ onto Phi = 0 and Phi_q v + Phi_t = 0, the least distance in the mass metric,
-  /// and solves v' and lambda there. The workspace then holds the projected state.
-  bool project(double t) {
+  /// y_dense_ = the continuous extension of the last attempt at t.
+  void dense_state(double t) {
+    static constexpr double d1 = -12715105075.0 / 11282082432.0,
+                            d3 = 87487479700.0 / 32700410799.0,
+                            d4 = -10690763975.0 / 1880347072.0,
+                            d5 = 701980252875.0 / 199316789632.0,
+                            d6 = -1453857185.0 / 822651844.0, d7 = 69997945.0 / 29380423.0;
+    const double theta = (t - t_n_) / h_, rest = 1.0 - theta;
+    // y(theta) = y_n + theta (dy + rest (b + theta (c + rest d))) with dy = y_{n+1} - y_n,
+    // b = h k_1 - dy, c = dy - h k_7 - b and d = h (d1 k_1 + d3 k_3 + ... + d7 k_7).
+    stage_ = h_ * (d1 * k_[0] + d3 * k_[2] + d4 * k_[3] + d5 * k_[4] + d6 * k_[5] + d7 * k_new_);
+    y_dense_ = y_trial_ - y_n_;                                   // dy
+    stage_ = (y_dense_ - h_ * k_new_ - (h_ * k_[0] - y_dense_)) + rest * stage_;  // c + rest d
+    stage_ = (h_ * k_[0] - y_dense_) + theta * stage_;            // b + theta (...)
+    y_dense_ = y_n_ + theta * (y_dense_ + rest * stage_);
+  }
+
+  /// Moves y onto Phi = 0 and Phi_q v + Phi_t = 0, the least distance in the mass metric, and
+  /// solves v' and lambda there. The workspace then holds the projected state at t. With
+  /// `one_factorization` the matrix at y serves every solve (chord iterations): for output
+  /// points, whose v' and lambda then carry a relative error of the size of the correction but
+  /// feed nothing back into the integration.
+  bool project(double t, const Eigen::VectorXd& y, bool one_factorization = false) {
     ws_.t = t;
-    ws_.q = y_new_.head(nq_total_);
+    ws_.q = y.head(nq_total_);
     for (int b = 0; b < model_.num_bodies(); ++b)
       Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = y_new_.tail(nv_total_);
+    ws_.v = y.tail(nv_total_);
     update_frames(model_, ws_);
     evaluate_constraints(model_, ws_);
     for (int k = 0; m_ > 0; ++k) {
-      if (!factorize()) return false;
+      if ((k == 0 || !one_factorization) && !factorize()) return false;
       if (ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance) break;
       if (k == settings_.max_projection_iterations) return false;
       // [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]: the smallest correction in the mass metric.
@@ -286,7 +348,9 @@ class DormandPrince {
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, size_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0, proposed_step_ = 1e-4;
   Eigen::VectorXd y_n_, y_new_, stage_, rhs_, solution_, velocity_residual_, vdot_n_, lambda_n_;
-  std::array<Eigen::VectorXd, 7> k_;
+  std::array<Eigen::VectorXd, 7> k_;  // stage derivatives of the last attempt
+  // The last attempt's projected end state, its v', lambda and derivative; a dense-output point.
+  Eigen::VectorXd y_trial_, vdot_trial_, lambda_trial_, k_new_, y_dense_;
 };
 
 }  // namespace odyn

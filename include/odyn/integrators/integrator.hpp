@@ -14,7 +14,8 @@
 //   rollback()    puts the workspace back at the committed state.
 //   restart()     forgets the history after a discontinuity of the forces.
 //   fail()        rolls back and throws the SolverError that explains the last failed attempt.
-// Fixed-step integrators (`adaptive()` false) are driven by attempt/commit alone.
+// Fixed-step integrators (`adaptive()` false) are driven by attempt/commit alone; adaptive ones
+// may also interpolate within a step (dense output), so that output times do not cut steps.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -93,6 +94,18 @@ concept AdaptiveIntegrator = StepIntegrator<I> && requires(I& i, const I& ci) {
   { ci.proposed_step() } -> std::convertible_to<double>;
   i.accept();
   i.reject();
+};
+
+/// An adaptive integrator with dense output: interpolate(t) puts the state at a time t within
+/// the last attempted step into the workspace (consistent, with v' and lambda), and
+/// restore_trial() puts the attempt's end state back. Output times then need not cut the steps.
+/// interpolate_frames(t) is the cheap version for event location: positions and velocities
+/// as interpolated, and the frames from them (no projection, no v').
+template <class I>
+concept DenseOutputIntegrator = AdaptiveIntegrator<I> && requires(I& i, double t) {
+  { i.interpolate(t) } -> std::same_as<bool>;
+  i.restore_trial();
+  i.interpolate_frames(t);
 };
 
 }  // namespace odyn
