@@ -38,8 +38,10 @@ struct GeneralizedAlphaSettings {
   /// Step-size control from the local error estimate, with the tolerances of StepControl;
   /// otherwise fixed steps.
   bool adaptive = false;
-  /// Largest factor by which an adaptive step may grow from one step to the next.
-  double max_growth = 2.0;
+  /// Largest factor by which an adaptive step may grow from one step to the next. Kept small:
+  /// every change of h costs the index-3 scheme some accuracy (on the engine, 1.2 gives 3 to 8
+  /// times smaller errors than 2 for the same number of steps).
+  double max_growth = 1.2;
 };
 
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
