@@ -51,4 +51,20 @@ TEST_CASE("a time step allocates nothing, events and restarts included", "[works
 #endif
 }
 
+TEST_CASE("a BDF step allocates nothing, events and restarts included", "[workspace][bdf]") {
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  odyn::Bdf<engine::Model> integrator(e.model, ws, {}, {.rtol = 1e-8, .atol = 1e-8});
+  odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
+  allocations = 0;
+  counting = true;
+  odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+  counting = false;
+  CHECK(integrator.statistics().events >= 2);
+#ifndef __SANITIZE_ADDRESS__
+  CHECK(allocations == 0);
+#endif
+}
+
 }  // namespace test_allocation

@@ -13,6 +13,7 @@
 
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/integrators/bdf.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/generalized_alpha.hpp"
 #include "odyn/integrators/integrator.hpp"
@@ -34,6 +35,7 @@ struct DynamicsSettings {
   double max_step = 0.0;  // s; 0: no limit
   GeneralizedAlphaSettings generalized_alpha = {};
   DormandPrinceSettings dormand_prince = {};
+  BdfSettings bdf = {};
   AssemblySettings assembly = {};
 };
 
@@ -166,6 +168,10 @@ template <>
 inline DormandPrinceSettings integrator_settings(const DynamicsSettings& s) {
   return s.dormand_prince;
 }
+template <>
+inline BdfSettings integrator_settings(const DynamicsSettings& s) {
+  return s.bdf;
+}
 
 inline StepControl step_control(const DynamicsSettings& s) {
   return StepControl{.rtol = s.rtol, .atol = s.atol, .first_step = s.step,
@@ -181,6 +187,7 @@ inline const std::vector<std::pair<std::string, std::string>>& integrator_names(
        "index-3 generalized-alpha (Chung-Hulbert), fixed step h or, with adaptive, rtol/atol"},
       {"hht", "index-3 HHT-alpha, fixed step h or, with adaptive, rtol/atol"},
       {"dopri5", "explicit Dormand-Prince 5(4), index 1 with projection, rtol/atol"},
+      {"bdf", "implicit BDF of orders 1-5, stabilized index 2 (GGL), rtol/atol"},
   };
   return names;
 }
@@ -237,6 +244,7 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
     return simulate_with<GeneralizedAlpha>(model, ws, s, observe);
   if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);
+  if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe);
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
   throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);

@@ -1,0 +1,597 @@
+#pragma once
+// Variable-step, variable-order BDF (orders 1-5) on the stabilized index-2 formulation of
+// Gear, Gupta & Leimkuhler, with error control on positions and velocities:
+//   q' = T(q) (v + M^-1 Phi_q^T mu),   M v' + Phi_q^T lambda = Q(q, v, t),
+//   Phi(q, t) = 0,                      Phi_q v + Phi_t = 0.
+// T is the configuration rate (the quaternion rate of spatial bodies); the quaternion is kept
+// as 4 numbers and renormalized after every step. mu vanishes on the exact solution; it moves
+// q back onto Phi = 0 in the mass metric (M^-1 keeps the units of q' consistent).
+//
+// q and v follow the variable-coefficient BDF of order k: the derivative at t_{n+1} of the
+// polynomial through y_{n+1} and the k last values, y_{n+1} = beta + c y'_{n+1}, c = h / alpha_0.
+// Given u = M^-1 Phi_q^T mu, q_{n+1} = beta_q + c T(q_{n+1}) (v + u) is linear in q_{n+1} (T is
+// affine in q), so it is solved exactly body by body; the unknowns of the simplified Newton
+// iteration are v, lambda and u. The (v, lambda) correction solves
+//   [M + c C + c^2 K, Phi_q^T; Phi_q, 0] [dv; c dlambda] = -[c R_dyn; Phi_q v + Phi_t]
+// (the library's saddle-point solver; the K u coupling is left out), and the u correction is the
+// least correction in the mass metric that removes the rest of Phi:
+//   [M, Phi_q^T; Phi_q, 0] [du; .] = [0; -Phi / c - Phi_q dv].
+// Both factorizations are kept across iterations and steps while Newton converges well and c
+// stays within a band (c enters the right-hand sides, so only the stiff blocks see its change).
+//
+// Error estimate, step and order selection follow DASSL: the local error of order k is
+// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| with y_pred the polynomial extrapolation of
+// the last k+1 values (lambda and mu, of index 3 and 2, stay out of the test); estimates at
+// orders k-1 and k+1 from divided differences choose the order; the step doubles at most and
+// shrinks on rejection. A (re)start begins at order 1 with a step from an estimate of y'' and a
+// fictitious past value y_n - h y'_n; order and step then grow every step until the first
+// rejection.
+//
+// K. E. Brenan, S. L. Campbell, L. R. Petzold, "Numerical Solution of Initial-Value Problems in
+// Differential-Algebraic Equations", SIAM 1996, Ch. 3 and 5 (DASSL); C. W. Gear, B. Leimkuhler,
+// G. K. Gupta, "Automatic integration of Euler-Lagrange equations with constraints", J. Comput.
+// Appl. Math. 12-13 (1985) 77-90.
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/core/errors.hpp"
+#include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/saddle_point.hpp"
+
+namespace odyn {
+
+struct BdfSettings {
+  int max_order = 5;  // 1 to 5
+  /// Newton stops when the estimated distance to the solution, in units of the error
+  /// tolerance, is below this...
+  double newton_tolerance = 0.1;
+  /// ... and every entry of Phi is below this.
+  double constraint_tolerance = 1e-10;
+  int max_iterations = 5;
+  /// A step that needs more iterations refactorizes for the next one.
+  int reuse_iterations = 3;
+  /// The factorization is kept while c = h / alpha_0 stays within this factor of its value.
+  double reuse_band = 1.3;
+  /// Largest factor by which a step may grow from one step to the next.
+  double max_growth = 2.0;
+};
+
+template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
+class Bdf {
+ public:
+  using Settings = BdfSettings;
+  using Space = typename Model::Space;
+  static constexpr int nv = Model::nv;
+  static constexpr int nq = Model::nq;
+  static constexpr int kMaxOrder = 5;
+  static constexpr int kHistory = kMaxOrder + 2;  // past values the estimates need
+
+  Bdf(const Model& model, Workspace<Model>& ws, Settings settings = {}, StepControl control = {})
+      : model_(model),
+        ws_(ws),
+        settings_(settings),
+        control_(control),
+        proposed_step_(std::min(control.first_step, control.max_step)) {
+    if (!(control.rtol > 0.0) || !(control.atol > 0.0))
+      throw ModelError("bdf", "rtol and atol must be positive, got " + to_text(control.rtol) +
+                                  " and " + to_text(control.atol));
+    if (!(proposed_step_ > 0.0))
+      throw ModelError("bdf", "the first step must be positive, got " + to_text(proposed_step_));
+    if (settings.max_order < 1 || settings.max_order > kMaxOrder)
+      throw ModelError("bdf", "max_order must lie in [1, 5], got " +
+                                  std::to_string(settings.max_order));
+    if (!(settings.newton_tolerance > 0.0) || !(settings.constraint_tolerance > 0.0) ||
+        settings.max_iterations < 1 || !(settings.reuse_band >= 1.0) ||
+        !(settings.max_growth > 1.0))
+      throw ModelError("bdf",
+                       "newton_tolerance and constraint_tolerance must be positive, "
+                       "max_iterations at least 1, reuse_band at least 1 and max_growth above 1");
+    nq_total_ = model.num_coordinates();
+    nv_total_ = model.num_velocities();
+    m_ = model.num_equations();
+    ny_ = nq_total_ + nv_total_;
+    const Eigen::Index size = ny_ + m_;  // history values carry lambda for the predictor
+    for (auto& y : history_) y = Eigen::VectorXd::Zero(size);
+    for (auto& w : differences_) w = Eigen::VectorXd::Zero(ny_);
+    predicted_ = Eigen::VectorXd::Zero(size);
+    beta_ = Eigen::VectorXd::Zero(ny_);
+    y_new_ = Eigen::VectorXd::Zero(size);
+    scratch_ = Eigen::VectorXd::Zero(ny_);
+    derivative_ = Eigen::VectorXd::Zero(ny_);
+    u_ = Eigen::VectorXd::Zero(nv_total_);
+    dv_ = Eigen::VectorXd::Zero(nv_total_);
+    du_ = Eigen::VectorXd::Zero(nv_total_);
+    vdot_probe_ = Eigen::VectorXd::Zero(nv_total_);
+    rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
+    solution_ = rhs_;
+    velocity_residual_ = Eigen::VectorXd::Zero(m_);
+    q_n_ = ws.q;
+    v_n_ = ws.v;
+    vdot_n_ = ws.vdot;
+    lambda_n_ = ws.lambda;
+    solver_.analyze(model);
+    projector_.analyze(model);
+    initialize();
+  }
+
+  /// Takes the workspace's state as the committed one and starts afresh at order 1.
+  void initialize() {
+    t_n_ = ws_.t;
+    q_n_ = ws_.q;
+    v_n_ = ws_.v;
+    restart();
+  }
+
+  /// Tries a step of size h from the committed state (which it leaves untouched). The
+  /// workspace then holds the trial state with its v' and lambda. False if Newton failed.
+  bool attempt(double h) {
+    h_ = h;
+    newton_failed_ = true;
+    error_ = std::numeric_limits<double>::infinity();
+    coefficients(h);
+    for (int tries = 0; tries < 2; ++tries) {
+      const bool fresh = !factorized_ || std::abs(std::log(c_ / c_factorized_)) >
+                                             std::log(settings_.reuse_band);
+      if (fresh) factorized_ = false;
+      if (solve_step(t_n_ + h)) {
+        newton_failed_ = false;
+        estimate_error();
+        return std::isfinite(error_);
+      }
+      factorized_ = false;  // a stale matrix may be the cause: once more with a fresh one
+      if (fresh) break;
+    }
+    return false;
+  }
+
+  /// Local error of the last attempt in units of the tolerance (accept when <= 1).
+  double error_norm() const { return error_; }
+
+  /// Commits the last attempt and chooses the next order and step (Brenan et al., Sect. 5.2).
+  void accept() {
+    commit();
+    failures_ = 0;
+    const int k = order_;
+    // Terms ~ |h^(j+1) y^(j+1)| from the divided differences through the new value.
+    double term_lower = std::numeric_limits<double>::infinity();
+    double term_higher = std::numeric_limits<double>::infinity();
+    const bool can_raise = k < settings_.max_order && count_ >= k + 3;
+    divided_difference_terms(k, can_raise, term_lower, term_higher);
+    const double term = (k + 1) * error_;
+    int new_order = k;
+    double estimate = error_;
+    if (k > 1 && term_lower <= term && term_lower <= term_higher) {
+      new_order = k - 1;
+      estimate = term_lower / k;
+    } else if (starting_ && k < settings_.max_order) {
+      new_order = k + 1;  // starting phase: raise until the first rejection
+    } else if (can_raise && steps_at_order_ >= k + 1 && term_higher < term) {
+      new_order = k + 1;
+      estimate = term_higher / (k + 2);
+    }
+    if (new_order == k - 1 || (starting_ && new_order == k)) starting_ = false;
+    if (hold_ > 0) --hold_;
+    double factor = std::pow(2.0 * estimate + 1e-4, -1.0 / (new_order + 1));
+    if (starting_ && factor >= 1.0) factor = settings_.max_growth;
+    // Keep h (and the factorization) unless the error allows doubling or asks for less.
+    if (factor >= settings_.max_growth)
+      factor = hold_ > 0 ? 1.0 : settings_.max_growth;
+    else if (factor <= 1.0)
+      factor = std::clamp(factor, 0.5, 0.9);
+    else
+      factor = 1.0;
+    if (new_order != k) steps_at_order_ = 0;
+    order_ = new_order;
+    const double grown = h_ * factor;
+    // A step cut short to land on an output time says nothing against the longer step.
+    proposed_step_ =
+        std::min(control_.max_step, h_ < proposed_step_ ? std::max(proposed_step_, grown) : grown);
+  }
+
+  /// Rejects the last attempt: a shorter step, and a lower order after repeated failures.
+  /// Throws once the step is hopelessly short.
+  void reject() {
+    ++statistics_.rejected_steps;
+    ++failures_;
+    starting_ = false;
+    double factor = 0.25;
+    if (!newton_failed_ && failures_ == 1)
+      factor = std::clamp(0.9 * std::pow(2.0 * error_ + 1e-4, -1.0 / (order_ + 1)), 0.25, 0.9);
+    else if (failures_ == 2)
+      order_ = std::max(1, order_ - 1);
+    else if (failures_ > 2)
+      order_ = 1;
+    if (failures_ >= 2) steps_at_order_ = 0;
+    // No growth for a few steps after a rejection, or h would bounce between the two sizes.
+    hold_ = order_ + 1;
+    proposed_step_ = h_ * factor;
+    if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_))) {
+      if (newton_failed_) fail();
+      const double t_failed = t_n_ + h_;
+      rollback();
+      throw SolverError(t_failed, "bdf: the step size fell below " + to_text(control_.min_step) +
+                                      " s without meeting the tolerances (order " +
+                                      std::to_string(order_) + ", error " + to_text(error_) +
+                                      " times the tolerance); loosen rtol/atol or look for a "
+                                      "discontinuity that no event locates");
+    }
+    rollback();
+  }
+
+  /// Makes the trial state of the last attempt the committed one (no step-size change).
+  void commit() {
+    statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
+    y_new_ << ws_.q, ws_.v, ws_.lambda;
+    push(y_new_, ws_.t);
+    t_n_ = ws_.t;
+    q_n_ = ws_.q;
+    v_n_ = ws_.v;
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    advance_states(model_, ws_);
+    ++statistics_.steps;
+    ++steps_at_order_;
+  }
+
+  /// After a switch of a force law (and at the start): v' and lambda afresh at the committed
+  /// state, the history reduced to it and its derivative, order 1 and a step that suits it.
+  void restart() {
+    ws_.q = q_n_;
+    ws_.v = v_n_;
+    consistent_accelerations(t_n_);
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    rates(ws_.q, ws_.v, ws_.vdot, derivative_);
+    // y'' by a finite difference along the motion, for the first step: order 1 leaves an error
+    // of about h^2 |y''| / 2 (DASSL's estimate); aim at a quarter of the tolerance.
+    const double delta = 1e-7 * std::max(1.0, std::abs(t_n_));
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Space::integrate(q_n_.template segment<nq>(b * nq),
+                       (delta * v_n_.template segment<nv>(b * nv)).eval(),
+                       ws_.q.template segment<nq>(b * nq));
+    ws_.v = v_n_ + delta * vdot_n_;
+    consistent_accelerations(t_n_ + delta);
+    vdot_probe_ = ws_.vdot;
+    rates(ws_.q, ws_.v, vdot_probe_, scratch_);
+    scratch_ = (scratch_ - derivative_) / delta;
+    y_new_ << q_n_, v_n_, lambda_n_;
+    const double curvature = weighted_rms_norm(scratch_, y_new_.head(ny_), y_new_.head(ny_),
+                                               control_.rtol, control_.atol);
+    double h0 = curvature > 0.0 ? std::sqrt(0.5 / curvature) : proposed_step_;
+    if (statistics_.restarts == 0) h0 = std::min(h0, control_.first_step);
+    h0 = std::min(h0, control_.max_step);
+    proposed_step_ = h0;
+    // The history: the committed value, and a fictitious one a step back along y'.
+    history_[0] = y_new_;
+    times_[0] = t_n_;
+    history_[1] = y_new_;
+    history_[1].head(ny_) -= h0 * derivative_;
+    times_[1] = t_n_ - h0;
+    count_ = 2;
+    order_ = 1;
+    steps_at_order_ = 0;
+    failures_ = 0;
+    hold_ = 0;
+    starting_ = true;
+    factorized_ = false;
+    ++statistics_.restarts;
+    rollback();
+  }
+
+  /// Puts the workspace back at the last committed state.
+  void rollback() {
+    ws_.t = t_n_;
+    ws_.q = q_n_;
+    ws_.v = v_n_;
+    ws_.vdot = vdot_n_;
+    ws_.lambda = lambda_n_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+  }
+
+  /// Rolls back and throws the SolverError that explains the last failed attempt.
+  [[noreturn]] void fail() {
+    const std::string message = failure_message();
+    const double t_failed = t_n_ + h_;
+    rollback();
+    throw SolverError(t_failed, message);
+  }
+
+  bool adaptive() const { return true; }
+  double time() const { return t_n_; }
+  double proposed_step() const { return proposed_step_; }
+  int order() const { return order_; }
+  void count_event() { ++statistics_.events; }
+  const IntegratorStatistics& statistics() const { return statistics_; }
+  const Settings& settings() const { return settings_; }
+
+ private:
+  /// Adds a committed value to the history (the oldest drops out; swaps allocate nothing).
+  void push(const Eigen::VectorXd& y, double t) {
+    for (int i = kHistory - 1; i > 0; --i) {
+      history_[i].swap(history_[i - 1]);
+      times_[i] = times_[i - 1];
+    }
+    history_[0] = y;
+    times_[0] = t;
+    count_ = std::min(count_ + 1, kHistory);
+  }
+
+  /// (T(q) v, v') for every body.
+  void rates(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& vdot,
+             Eigen::VectorXd& out) const {
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      out.template segment<nq>(b * nq) = Space::configuration_rate(
+          q.template segment<nq>(b * nq), v.template segment<nv>(b * nv));
+    out.tail(nv_total_) = vdot;
+  }
+
+  /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at (ws.q, ws.v, t).
+  void consistent_accelerations(double t) {
+    ws_.t = t;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+    evaluate_gamma(model_, ws_);
+    ++statistics_.residual_evaluations;
+    ++statistics_.factorizations;
+    factorized_ = false;  // the projector's factorization is reused here
+    if (!projector_.factorize(model_, ws_, IterationFactors{}))
+      throw SolverError(t,
+                        "bdf: the mass-constraint matrix is singular; check for redundant or "
+                        "locked constraints");
+    rhs_.head(nv_total_) = ws_.force;
+    rhs_.tail(m_) = ws_.gamma;
+    projector_.solve(rhs_, solution_);
+    ws_.vdot = solution_.head(nv_total_);
+    ws_.lambda = solution_.tail(m_);
+  }
+
+  /// Predictor weights (extrapolation through the last k+1 values) and the corrector
+  /// y_{n+1} = beta + c y'_{n+1} of order k for a step h; also the predicted values.
+  void coefficients(double h) {
+    const int k = order_;
+    const double t_new = t_n_ + h;
+    // Corrector: derivative at t_new of the Lagrange basis through t_new, t_n, ..., t_{n+1-k}.
+    std::array<double, kHistory + 1> tau{};
+    tau[0] = t_new;
+    for (int j = 1; j <= k + 1; ++j) tau[j] = times_[j - 1];
+    double lead = 0.0;
+    for (int i = 1; i <= k; ++i) lead += 1.0 / (t_new - tau[i]);
+    c_ = 1.0 / lead;
+    beta_.setZero();
+    for (int j = 1; j <= k; ++j) {
+      double numerator = 1.0, denominator = 1.0;
+      for (int i = 0; i <= k; ++i) {
+        if (i == j) continue;
+        if (i != 0) numerator *= t_new - tau[i];
+        denominator *= tau[j] - tau[i];
+      }
+      beta_.noalias() -= (c_ * numerator / denominator) * history_[j - 1].head(ny_);
+    }
+    // Predictor: the polynomial through t_n, ..., t_{n-k}, at t_new.
+    predicted_.setZero();
+    for (int j = 1; j <= k + 1; ++j) {
+      double weight = 1.0;
+      for (int i = 1; i <= k + 1; ++i)
+        if (i != j) weight *= (t_new - tau[i]) / (tau[j] - tau[i]);
+      predicted_.noalias() += weight * history_[j - 1];
+    }
+  }
+
+  /// q_{n+1} from q = beta_q + c T(q) (v + u), body by body (T is affine in q), normalized; v'
+  /// from the BDF formula; then frames, blocks and forces at the trial state.
+  void set_state(double t_new) {
+    using Configuration = Eigen::Matrix<double, nq, 1>;
+    using Velocity = Eigen::Matrix<double, nv, 1>;
+    using Square = Eigen::Matrix<double, nq, nq>;
+    for (int b = 0; b < model_.num_bodies(); ++b) {
+      const Velocity w = ws_.v.template segment<nv>(b * nv) + u_.template segment<nv>(b * nv);
+      const Configuration offset = Space::configuration_rate(Configuration::Zero(), w);
+      Square matrix = Square::Identity();
+      for (int i = 0; i < nq; ++i)
+        matrix.col(i) -= c_ * (Space::configuration_rate(Configuration::Unit(i), w) - offset);
+      const Configuration right = beta_.template segment<nq>(b * nq) + c_ * offset;
+      auto q = ws_.q.template segment<nq>(b * nq);
+      q = matrix.partialPivLu().solve(right);
+      Space::normalize(q);
+    }
+    ws_.vdot = (ws_.v - beta_.tail(nv_total_)) / c_;
+    ws_.t = t_new;
+    ++statistics_.residual_evaluations;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+  }
+
+  /// Newton's right-hand side at the workspace's state: -[c (M v' - Q + Phi_q^T lambda);
+  /// Phi_q v + Phi_t]. False if it is not finite.
+  bool residuals() {
+    auto dynamics = rhs_.head(nv_total_);
+    mass_times(model_, ws_.vdot, dynamics);
+    dynamics -= ws_.force;
+    add_jacobian_transpose_times(model_, ws_, ws_.lambda, dynamics);
+    dynamics *= -c_;
+    jacobian_times(model_, ws_, ws_.v, velocity_residual_);
+    velocity_residual_ += ws_.phi_t;
+    rhs_.tail(m_) = -velocity_residual_;
+    return rhs_.allFinite() && ws_.phi.allFinite();
+  }
+
+  bool factorize() {
+    ++statistics_.jacobian_evaluations;
+    statistics_.factorizations += m_ > 0 ? 2 : 1;
+    factorized_ = solver_.factorize(model_, ws_, IterationFactors{1.0, c_ * c_, c_}) &&
+                  (m_ == 0 || projector_.factorize(model_, ws_, IterationFactors{}));
+    c_factorized_ = c_;
+    rate_factor_ = 100.0;  // no convergence rate known for a new matrix (DASSL's S)
+    return factorized_;
+  }
+
+  /// Weighted RMS size of a correction (c (dv + du) in the tangent coordinates of q, and dv),
+  /// in units of the tolerance.
+  double correction_norm() const {
+    double sum = 0.0;
+    for (int b = 0; b < model_.num_bodies(); ++b) {
+      const auto scale = Space::coordinate_scale(ws_.q.template segment<nq>(b * nq));
+      for (int i = 0; i < nv; ++i) {
+        const Eigen::Index j = b * nv + i;
+        const double dq = c_ * (dv_[j] + du_[j]) / (control_.atol + control_.rtol * scale[i]);
+        const double dv = dv_[j] / (control_.atol + control_.rtol * std::abs(ws_.v[j]));
+        sum += dq * dq + dv * dv;
+      }
+    }
+    return nv_total_ > 0 ? std::sqrt(sum / static_cast<double>(2 * nv_total_)) : 0.0;
+  }
+
+  /// Simplified Newton from the predicted values; the workspace holds the result.
+  bool solve_step(double t_new) {
+    ws_.v = predicted_.segment(nq_total_, nv_total_);
+    ws_.lambda = predicted_.tail(m_);
+    u_.setZero();
+    set_state(t_new);
+    if (!residuals()) return false;
+    if (!factorized_ && !factorize()) return false;
+    double first_norm = 0.0;
+    for (int k = 0; k < settings_.max_iterations; ++k) {
+      solver_.solve(rhs_, solution_);
+      dv_ = solution_.head(nv_total_);
+      ws_.lambda += solution_.tail(m_) / c_;
+      if (m_ > 0) {
+        // Phi_q dv = -(Phi_q v + Phi_t) holds for the matrix's Phi_q, so the rest of Phi is
+        // -Phi / c + (Phi_q v + Phi_t).
+        rhs_.head(nv_total_).setZero();
+        rhs_.tail(m_) = -ws_.phi / c_ + velocity_residual_;
+        projector_.solve(rhs_, solution_);
+        du_ = solution_.head(nv_total_);
+      } else {
+        du_.setZero();
+      }
+      ++statistics_.newton_iterations;
+      const double norm = correction_norm();
+      ws_.v += dv_;
+      u_ += du_;
+      set_state(t_new);
+      if (!residuals() || !std::isfinite(norm)) return false;
+      // Converged when the estimated distance to the solution, rate / (1 - rate) times the
+      // last correction, is small (Brenan et al., Sect. 5.2.2); the rate from this step's
+      // iterations, or the last one's while the matrix is the same.
+      // A correction at the level of rounding says nothing about the rate.
+      const bool negligible = norm <= 1e-3 * settings_.newton_tolerance;
+      if (k == 0) {
+        first_norm = norm;
+      } else if (!negligible) {
+        const double rate = first_norm > 0.0 ? std::pow(norm / first_norm, 1.0 / k) : 0.0;
+        if (rate > 0.9) return false;
+        rate_factor_ = rate / (1.0 - rate);
+      }
+      const bool small = negligible || rate_factor_ * norm <= settings_.newton_tolerance;
+      if (small &&
+          (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
+        if (k + 1 > settings_.reuse_iterations) factorized_ = false;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| in units of the tolerance.
+  void estimate_error() {
+    const int k = order_;
+    scratch_.head(nq_total_) = ws_.q - predicted_.head(nq_total_);
+    scratch_.tail(nv_total_) = ws_.v - predicted_.segment(nq_total_, nv_total_);
+    y_new_ << ws_.q, ws_.v, ws_.lambda;
+    const double span = ws_.t - times_[k];
+    error_ = (h_ / span) * weighted_rms_norm(scratch_, predicted_.head(ny_), y_new_.head(ny_),
+                                             control_.rtol, control_.atol);
+  }
+
+  /// After commit: |h^(j+1) (j+1)! [y_{n+1}, ..., y_{n-j}]| for j = k-1 (if k > 1) and k+1
+  /// (if asked), the terms DASSL compares to choose the order.
+  void divided_difference_terms(int k, bool higher, double& lower, double& upper) {
+    const int last = std::min(higher ? k + 2 : k, count_ - 1);  // highest difference needed
+    for (int i = 0; i <= last; ++i) differences_[i] = history_[i].head(ny_);
+    double factorial = 1.0, power = 1.0;
+    for (int l = 1; l <= last; ++l) {
+      for (int i = 0; i + l <= last; ++i)
+        differences_[i] = (differences_[i] - differences_[i + 1]) / (times_[i] - times_[i + l]);
+      factorial *= l;
+      power *= h_;
+      const double term = factorial * power *
+                          weighted_rms_norm(differences_[0], history_[0].head(ny_),
+                                            history_[0].head(ny_), control_.rtol, control_.atol);
+      if (l == k && k > 1) lower = term;  // difference of order k: the order k-1 term
+      if (l == k + 2 && higher) upper = term;
+    }
+  }
+
+  std::string failure_message() const {
+    if (!rhs_.allFinite() || !ws_.force.allFinite()) {
+      std::string culprit = "an element";
+      model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+        if constexpr (ForceElement<E>) {
+          const auto& blocks = std::get<type>(ws_.blocks);
+          for (std::size_t i = 0; i < pool.size(); ++i)
+            for (const auto& f : blocks[i].force)
+              if (!f.allFinite()) culprit = "force element '" + pool[i].name() + "'";
+        }
+      });
+      return "bdf: Newton iteration produced a non-finite value; " + culprit +
+             " returned NaN or infinity. Check its parameters and inputs.";
+    }
+    std::string strongest;
+    double strongest_force = 0.0;
+    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+      if constexpr (ForceElement<E>) {
+        const auto& blocks = std::get<type>(ws_.blocks);
+        for (std::size_t i = 0; i < pool.size(); ++i)
+          for (const auto& f : blocks[i].force)
+            if (f.norm() > strongest_force) {
+              strongest_force = f.norm();
+              strongest = pool[i].name();
+            }
+      }
+    });
+    Eigen::Index row = 0;
+    const double worst = m_ > 0 ? ws_.phi.cwiseAbs().maxCoeff(&row) : 0.0;
+    return "bdf: Newton iteration did not converge in " +
+           std::to_string(settings_.max_iterations) + " iterations at order " +
+           std::to_string(order_) + ", step " + to_text(h_) +
+           " s (largest constraint residual " + to_text(worst) + " at '" +
+           (m_ > 0 ? model_.constraint_name(static_cast<int>(row)) : std::string("-")) + "'" +
+           (strongest.empty() ? std::string()
+                              : ", largest applied force from '" + strongest + "' (" +
+                                    to_text(strongest_force) + ")") +
+           "). Check the force elements' parameters, or look for a locked or singular mechanism.";
+  }
+
+  const Model& model_;
+  Workspace<Model>& ws_;
+  Settings settings_;
+  StepControl control_;
+  Solver solver_;     // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
+  Solver projector_;  // [M, Phi_q^T; Phi_q, 0]
+  IntegratorStatistics statistics_;
+  Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, ny_ = 0;
+  double t_n_ = 0.0, h_ = 0.0, c_ = 1.0, c_factorized_ = 1.0;
+  double error_ = 0.0, proposed_step_ = 1e-4, rate_factor_ = 100.0;
+  int order_ = 1, count_ = 0, steps_at_order_ = 0, failures_ = 0, hold_ = 0;
+  bool factorized_ = false, newton_failed_ = false, starting_ = true;
+
+  std::array<Eigen::VectorXd, kHistory> history_;  // (q, v, lambda) at times_, newest first
+  std::array<double, kHistory> times_{};
+  std::array<Eigen::VectorXd, kHistory> differences_;  // (q, v) divided differences
+  Eigen::VectorXd predicted_, beta_, y_new_, scratch_, derivative_, vdot_probe_;
+  Eigen::VectorXd u_, dv_, du_;  // u = M^-1 Phi_q^T mu and the corrections
+  Eigen::VectorXd rhs_, solution_, velocity_residual_;
+  Eigen::VectorXd q_n_, v_n_, vdot_n_, lambda_n_;
+};
+
+}  // namespace odyn
