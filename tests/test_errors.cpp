@@ -321,18 +321,60 @@ TEST_CASE("Names must be unique", "[errors]") {
   CHECK(model.num_equations() == 3);
 }
 
-TEST_CASE("Over-constrained mechanism: the redundant joints are named", "[errors]") {
-  // A door on two coaxial hinges: five of the second hinge's equations repeat the first's.
+/// A door on two coaxial hinges about z (points 1 m above and below its centre of mass): five
+/// of the second hinge's equations repeat the first's. `gap` moves the lower hinge's ground
+/// point down, so that the two hinges cannot both hold.
+Model two_hinged_door(double gap = 0.0) {
   Model model;
   const BodyId door = model.add_body(good_body("door"));
   model.add(sp::Revolute("upper hinge", odyn::ground, sp::JointFrame{{0, 0, 1}}, door,
                          sp::JointFrame{{0, 0, 1}}));
-  model.add(sp::Revolute("lower hinge", odyn::ground, sp::JointFrame{{0, 0, -1}}, door,
+  model.add(sp::Revolute("lower hinge", odyn::ground, sp::JointFrame{{0, 0, -1 - gap}}, door,
                          sp::JointFrame{{0, 0, -1}}));
+  return model;
+}
+
+TEST_CASE("Over-constrained mechanism: the redundant joints are named, and it runs",
+          "[errors]") {
+  Model model = two_hinged_door();
+  Workspace ws(model);
+  // The check for a model that must be free of redundancy still names them.
+  odyn::assemble(model, ws);
+  REQUIRE_THROWS_MATCHES(odyn::require_independent_constraints(model, ws), odyn::ModelError,
+                         ModelErrorAbout("hinge", {"redundant", "upper hinge", "lower hinge"}));
+  // A run goes on with the minimum-norm multipliers and reports the redundant equations: five,
+  // all of the hinges (which of the two is a choice).
+  Workspace run(model);
+  run.v[5] = 2.0;  // swinging about the hinge axis at 2 rad/s
+  odyn::RunSummary summary;
+  REQUIRE_NOTHROW(summary = odyn::simulate(model, run, short_run(), [](const Workspace&) {}));
+  REQUIRE(summary.redundant_equations.size() == 5);
+  for (const odyn::RedundantEquation& e : summary.redundant_equations) {
+    INFO(e.text());
+    CHECK((e.joint == "upper hinge" || e.joint == "lower hinge"));
+    CHECK(e.equation >= 0);
+    CHECK(e.equation < 5);
+    CHECK(model.constraint_name(e.row) == e.joint);
+    CHECK_THAT(e.text(), Catch::Contains(e.joint) && Catch::Contains("equation"));
+  }
+  // The door swings on: 0.4 rad in 0.2 s, still on its axis; no force acts, so the hinges
+  // carry nothing (the minimum-norm multipliers are zero, not an arbitrary self-stress).
+  CHECK(run.t == Approx(0.2));
+  CHECK(2.0 * std::atan2(run.q[6], run.q[3]) == Approx(0.4).epsilon(1e-9));
+  CHECK(run.q.head<3>().norm() < 1e-10);
+  CHECK(summary.max_position_residual < 1e-10);
+  CHECK(run.lambda.norm() < 1e-8);
+}
+
+TEST_CASE("Over-constrained mechanism whose constraints contradict each other", "[errors]") {
+  // The lower hinge's ground point 0.25 m too low: the door cannot meet both. The assembly
+  // names the hinges instead of running with a least-squares compromise.
+  Model model = two_hinged_door(0.25);
   Workspace ws(model);
   REQUIRE_THROWS_MATCHES(odyn::simulate(model, ws, short_run(), [](const Workspace&) {}),
-                         odyn::ModelError,
-                         ModelErrorAbout("hinge", {"redundant", "upper hinge", "lower hinge"}));
+                         odyn::AssemblyError,
+                         AssemblyErrorAbout("hinge", {"could not be satisfied", "largest residual",
+                                                      "upper hinge", "lower hinge"}));
 }
 
 TEST_CASE("Assembly that cannot converge", "[errors]") {

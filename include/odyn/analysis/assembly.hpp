@@ -6,6 +6,9 @@
 //     changes as little as possible in the kinetic-energy metric;
 //  3. accelerations and multipliers from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma].
 // Redundant constraint equations are reported by name (they make lambda non-unique).
+// A mechanism whose redundant equations are consistent (Bricard's linkage, two coaxial hinges)
+// assembles and runs: the solvers give the minimum-norm multipliers (linalg/saddle_point.hpp),
+// and redundant_equations(model, ws) says which equations repeat others.
 
 #include <Eigen/Core>
 #include <Eigen/QR>
@@ -32,7 +35,50 @@ struct AssemblyReport {
   std::vector<int> adjusted_velocity_components;  // given components it had to change
 };
 
+/// A constraint equation that depends on the others at the current pose.
+struct RedundantEquation {
+  std::string joint;  // the element's name
+  int equation = 0;   // index among the element's own equations (0-based)
+  int row = 0;        // row of Phi
+  /// "joint (equation k, row r)".
+  std::string text() const {
+    return joint + " (equation " + std::to_string(equation) + ", row " + std::to_string(row) +
+           ")";
+  }
+};
+
 namespace detail {
+/// The element that owns a constraint row, and the row's index among its equations.
+template <class Model>
+RedundantEquation locate_row(const Model& model, int row) {
+  RedundantEquation found;
+  found.row = row;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (Constraint<E>) {
+      const auto& offsets = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        if (row >= offsets[i] && row < offsets[i] + E::num_equations) {
+          found.joint = pool[i].name();
+          found.equation = row - offsets[i];
+        }
+    }
+  });
+  return found;
+}
+
+/// Rows of Phi_q that depend on earlier ones, in the pivot order of a rank-revealing QR of
+/// Phi_q^T (threshold relative to the largest pivot), sorted.
+inline std::vector<int> dependent_rows(const Eigen::MatrixXd& jacobian) {
+  std::vector<int> rows;
+  if (jacobian.rows() == 0) return rows;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(jacobian.transpose());
+  qr.setThreshold(1e-10);
+  for (Eigen::Index k = qr.rank(); k < jacobian.rows(); ++k)
+    rows.push_back(static_cast<int>(qr.colsPermutation().indices()[k]));
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
 template <class Model>
 Eigen::MatrixXd dense_jacobian(const Model& model, const Workspace<Model>& ws) {
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(model.num_equations(), model.num_velocities());
@@ -209,6 +255,19 @@ AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const Assembly
   ws.lambda = lambda;
   (void)n;
   return report;
+}
+
+/// The constraint equations that repeat what others impose at the workspace's pose (empty when
+/// Phi_q has full row rank). Their number is the rank deficiency of Phi_q; which ones are named
+/// is a choice (any equation of a dependent set could be), made by a pivoted QR.
+template <class Model>
+std::vector<RedundantEquation> redundant_equations(const Model& model, Workspace<Model>& ws) {
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  std::vector<RedundantEquation> redundant;
+  for (const int row : detail::dependent_rows(detail::dense_jacobian(model, ws)))
+    redundant.push_back(detail::locate_row(model, row));
+  return redundant;
 }
 
 /// Throws ModelError listing redundant constraint equations at the current pose, if any.

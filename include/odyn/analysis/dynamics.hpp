@@ -46,6 +46,10 @@ struct RunSummary {
   double wall_seconds = 0.0;
   double max_position_residual = 0.0;  // max |Phi| at the output times
   double max_velocity_residual = 0.0;  // max |Phi_q v + Phi_t| at the output times
+  /// Constraint equations that repeat others at the assembled pose (Phi_q rank-deficient): the
+  /// run goes on with the minimum-norm multipliers, and the reactions of these joints are then
+  /// one choice among many (see linalg/saddle_point.hpp). Empty for an ordinary mechanism.
+  std::vector<RedundantEquation> redundant_equations;
 };
 
 /// Norms of the position and velocity constraint residuals at the workspace's last evaluation.
@@ -212,7 +216,7 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   const auto start = std::chrono::steady_clock::now();
   RunSummary summary;
   summary.assembly = assemble(model, ws, s.assembly);
-  require_independent_constraints(model, ws);
+  summary.redundant_equations = redundant_equations(model, ws);
   Integrator integrator(model, ws,
                         detail::integrator_settings<typename Integrator::Settings>(s),
                         detail::step_control(s));

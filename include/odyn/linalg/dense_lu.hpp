@@ -2,9 +2,14 @@
 // Dense LU with partial pivoting behind the solver interface the analyses use
 // (Eigen's: analyze_pattern once per structure, factorize per matrix values, solve).
 // A sparse solver (KLU, CHOLMOD) slots in with the same four calls.
+//
+// A singular matrix (the saddle-point matrix of a mechanism with redundant constraints) can be
+// factorized instead by a rank-revealing complete orthogonal decomposition, whose solve gives
+// the minimum-norm least-squares solution; it is never used on the fast path.
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/QR>
 
 namespace odyn {
 
@@ -13,10 +18,14 @@ class DenseLu {
   using Matrix = Eigen::MatrixXd;
 
   /// Sizes the factorization once, so that later factorizations allocate nothing.
-  void analyze_pattern(const Matrix& a) { lu_ = Eigen::PartialPivLU<Matrix>(a.rows()); }
+  void analyze_pattern(const Matrix& a) {
+    lu_ = Eigen::PartialPivLU<Matrix>(a.rows());
+    rank_revealing_ = false;
+  }
 
   /// Factorizes; returns false if the matrix is numerically singular.
   bool factorize(const Matrix& a) {
+    rank_revealing_ = false;
     lu_.compute(a);
     // A zero or tiny pivot relative to the largest entry means a singular matrix.
     const double largest = lu_.matrixLU().cwiseAbs().maxCoeff();
@@ -24,14 +33,30 @@ class DenseLu {
     return smallest_pivot > 1e-13 * largest;
   }
 
-  /// x = A^-1 b (x and b must not alias).
+  /// Factorizes a possibly singular matrix by a complete orthogonal decomposition (rank decided
+  /// with `threshold` relative to the largest pivot); returns the rank deficiency. Later solves
+  /// give the minimum-norm least-squares solution, until the next factorize.
+  int factorize_rank_revealing(const Matrix& a, double threshold) {
+    rank_revealing_ = true;
+    cod_.setThreshold(threshold);
+    cod_.compute(a);
+    return static_cast<int>(a.rows() - cod_.rank());
+  }
+
+  /// x = A^-1 b (x and b must not alias); the minimum-norm solution after a rank-revealing
+  /// factorization.
   template <class Rhs, class Dst>
   void solve(const Rhs& b, Dst& x) const {
-    x.noalias() = lu_.solve(b);
+    if (rank_revealing_)
+      x.noalias() = cod_.solve(b);
+    else
+      x.noalias() = lu_.solve(b);
   }
 
  private:
   Eigen::PartialPivLU<Matrix> lu_;
+  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
+  bool rank_revealing_ = false;
 };
 
 }  // namespace odyn

@@ -9,10 +9,36 @@
 //    bodies in the Newton matrix), inverts A body by body and factorizes only the m x m Schur
 //    complement B A^-1 B^T; several times cheaper for small and medium models. It falls back
 //    to the dense solver by itself when A is not block diagonal.
+//
+// Redundant constraints. When B = Phi_q is rank-deficient (a mechanism whose joints repeat one
+// another's equations, such as Bricard's linkage, or two coaxial hinges), the matrix is singular
+// but the system is still solvable for a consistent right-hand side: x is unique, y is not (any
+// vector of the null space of B^T may be added to it). Both solvers then return the
+// minimum-norm y, the one orthogonal to that null space. For the multipliers this means that
+// the joint reactions of an over-constrained mechanism are not unique: the physics fixes only
+// B^T lambda, the sum of the constraint forces on each body, and odyn reports the least-squares
+// distribution of it over the joints. Caveat: within a Newton iteration the solvers return
+// minimum-norm *corrections*, which cannot see the null-space part of the multipliers the
+// iteration started from. The multipliers are minimum-norm where they are solved outright (at
+// assembly and at every restart of an integrator); between restarts, an integrator that
+// extrapolates lambda from step to step carries a null-space part along, which grows as the
+// null space turns with the pose, unless it projects lambda after each step (rank_deficiency()
+// says when that is needed). B^T lambda, and so the motion, is unaffected.
+// An inconsistent right-hand side (constraints that cannot all hold, or a driver at a dead
+// point) gets the least-squares y: the constraint residual then does not vanish and the
+// caller's convergence test fails, so it never hides.
+// The rank is decided relative to the largest eigenvalue of S (or the largest entry of the
+// dense matrix), with threshold rank_tolerance. A full-rank system keeps the fast path:
+// Cholesky of S (the block Schur solver) or LU (the dense one); the rank-revealing
+// factorizations run only when that path finds a singular matrix.
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "odyn/analysis/system.hpp"
@@ -27,6 +53,10 @@ struct IterationFactors {
   double damping = 0.0;
 };
 
+/// Relative size below which an eigenvalue of S (or a pivot of the dense matrix) counts as zero:
+/// the equations it belongs to are redundant.
+inline constexpr double rank_tolerance = 1e-10;
+
 template <class Model>
 class DenseSaddlePoint {
  public:
@@ -35,21 +65,33 @@ class DenseSaddlePoint {
     const int size = n_ + model.num_equations();
     matrix_ = Eigen::MatrixXd::Zero(size, size);
     lu_.analyze_pattern(matrix_);
+    rank_deficiency_ = 0;
   }
 
+  /// Factorizes by LU; if the matrix is singular (redundant constraints), by a complete
+  /// orthogonal decomposition whose solve gives the minimum-norm solution. False only if the
+  /// matrix holds non-finite values.
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     matrix_.setZero();
     add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping);
     write_jacobian(model, ws, matrix_, n_, 0, true);
-    return lu_.factorize(matrix_);
+    rank_deficiency_ = 0;
+    if (lu_.factorize(matrix_)) return true;
+    if (!matrix_.allFinite()) return false;
+    rank_deficiency_ = lu_.factorize_rank_revealing(matrix_, rank_tolerance);
+    return true;
   }
 
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) const {
     lu_.solve(rhs, solution);
   }
 
+  /// Number of dependent rows of the last factorized matrix (0: full rank).
+  int rank_deficiency() const { return rank_deficiency_; }
+
  private:
   int n_ = 0;
+  int rank_deficiency_ = 0;
   Eigen::MatrixXd matrix_;  // (n + m) x (n + m)
   DenseLu lu_;
 };
@@ -147,8 +189,13 @@ class BlockSchurSaddlePoint {
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
     schur_llt_.compute(Eigen::MatrixXd::Identity(m_, m_));  // sizes it; info() defined
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
+    schur_eigen_ = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(m_);
+    inverse_eigenvalues_ = Eigen::VectorXd::Zero(m_);
     work_n_ = Eigen::VectorXd::Zero(n_);
     work_m_ = Eigen::VectorXd::Zero(m_);
+    work_eigen_ = Eigen::VectorXd::Zero(m_);
+    method_ = Method::cholesky;
+    rank_deficiency_ = 0;
   }
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
@@ -173,14 +220,47 @@ class BlockSchurSaddlePoint {
       for (Eigen::Index j = 0; j < size; ++j)
         for (Eigen::Index i = 0; i < size; ++i) schur_(rows[i], rows[j]) += local_[b](i, j);
     }
+    rank_deficiency_ = 0;
     if (m_ == 0) return true;
+    if (!schur_.allFinite()) return false;
+    // The fast path: Cholesky. Its pivots are the diagonal of L squared, and the smallest one
+    // bounds the smallest eigenvalue of S from above, so a tiny pivot flags a singular S.
     schur_llt_.compute(schur_);
-    use_lu_ = schur_llt_.info() != Eigen::Success;
-    if (!use_lu_) return true;
-    // Not positive definite (A itself is not): fall back to LU on the same matrix.
-    schur_lu_.compute(schur_);
-    const double largest = schur_lu_.matrixLU().cwiseAbs().maxCoeff();
-    return schur_lu_.matrixLU().diagonal().cwiseAbs().minCoeff() > 1e-13 * largest;
+    const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
+    if (schur_llt_.info() == Eigen::Success) {
+      const double smallest_pivot = schur_llt_.matrixLLT().diagonal().cwiseAbs2().minCoeff();
+      if (smallest_pivot > rank_tolerance * largest_diagonal) {
+        method_ = Method::cholesky;
+        return true;
+      }
+    } else {
+      // Not positive definite (A itself is not): LU on the same matrix, if it is regular.
+      schur_lu_.compute(schur_);
+      const double largest = schur_lu_.matrixLU().cwiseAbs().maxCoeff();
+      if (schur_lu_.matrixLU().diagonal().cwiseAbs().minCoeff() > rank_tolerance * largest) {
+        method_ = Method::lu;
+        return true;
+      }
+    }
+    // Singular: redundant (or, at a dead point, locked) constraints. The eigenvalues of the
+    // symmetric S decide its rank; the solve inverts only those above the threshold, which
+    // gives the minimum-norm y.
+    method_ = Method::eigen;
+    schur_eigen_.compute(schur_);
+    if (schur_eigen_.info() != Eigen::Success) return false;
+    const auto& eigenvalues = schur_eigen_.eigenvalues();
+    const double cutoff = rank_tolerance * eigenvalues.cwiseAbs().maxCoeff();
+    for (int i = 0; i < m_; ++i) {
+      const bool kept = std::abs(eigenvalues[i]) > cutoff;
+      inverse_eigenvalues_[i] = kept ? 1.0 / eigenvalues[i] : 0.0;
+      rank_deficiency_ += kept ? 0 : 1;
+    }
+    return true;
+  }
+
+  /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
+  int rank_deficiency() const {
+    return dense_fallback_ ? dense_.rank_deficiency() : rank_deficiency_;
   }
 
   /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
@@ -191,10 +271,19 @@ class BlockSchurSaddlePoint {
     if (m_ > 0) {
       work_m_.noalias() = jacobian_ * work_n_;
       work_m_ -= rhs.tail(m_);
-      if (use_lu_)
-        solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
-      else
-        solution.tail(m_).noalias() = schur_llt_.solve(work_m_);
+      switch (method_) {
+        case Method::cholesky:
+          solution.tail(m_).noalias() = schur_llt_.solve(work_m_);
+          break;
+        case Method::lu:
+          solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
+          break;
+        case Method::eigen:  // y = V D^+ V^T r
+          work_eigen_.noalias() = schur_eigen_.eigenvectors().transpose() * work_m_;
+          work_eigen_.array() *= inverse_eigenvalues_.array();
+          solution.tail(m_).noalias() = schur_eigen_.eigenvectors() * work_eigen_;
+          break;
+      }
       work_n_.noalias() = rhs.head(n_) - jacobian_.transpose() * solution.tail(m_);
       for (int b = 0; b < bodies_; ++b)
         solution.segment<nv>(b * nv).noalias() = inverses_[b] * work_n_.segment<nv>(b * nv);
@@ -204,10 +293,12 @@ class BlockSchurSaddlePoint {
   }
 
  private:
+  enum class Method { cholesky, lu, eigen };
   bool dense_fallback_ = false;
   DenseSaddlePoint<Model> dense_;
   int bodies_ = 0, n_ = 0, m_ = 0;
-  bool use_lu_ = false;
+  Method method_ = Method::cholesky;
+  int rank_deficiency_ = 0;
   std::vector<Block> blocks_;              // (nb) diagonal blocks of A
   std::vector<Block> inverses_;            // (nb) inverses of their symmetric parts
   std::vector<std::vector<int>> rows_;     // (nb) constraint rows acting on each body
@@ -217,7 +308,9 @@ class BlockSchurSaddlePoint {
   Eigen::MatrixXd schur_;                  // (m x m) S = B A^-1 B^T
   Eigen::LLT<Eigen::MatrixXd> schur_llt_;
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
-  Eigen::VectorXd work_n_, work_m_;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> schur_eigen_;  // singular S only
+  Eigen::VectorXd inverse_eigenvalues_;  // (m) 1/d_i, or 0 for the null space of S
+  Eigen::VectorXd work_n_, work_m_, work_eigen_;
 };
 
 }  // namespace odyn
