@@ -1,0 +1,501 @@
+// The hard cases of dynamic analysis, each against a reference that uses no odyn solver:
+//  - Bricard's linkage (redundant constraints everywhere): the rank deficiency from an SVD of
+//    Phi_q, energy conservation, and the multipliers against the applied and inertial forces;
+//  - a parallelogram four-bar driven through its change points, against the closed-form motion
+//    of its parallelogram branch, and a driven linkage that locks;
+//  - the heavy top on the rotation group, against an RK4 solution of Euler's equations with a
+//    quaternion written here;
+//  - a stiff spring-mass chain far beyond the explicit stability limit, against its modal
+//    solution and the spectral radius rho_inf;
+//  - an undamped double pendulum over 1000 s: energy and constraint drift.
+// The models are in examples/*_model.hpp, so that the benchmarks can reuse them.
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <odyn/odyn.hpp>
+
+#include "bricard_model.hpp"
+#include "double_pendulum_model.hpp"
+#include "heavy_top_model.hpp"
+#include "parallelogram_model.hpp"
+#include "stiff_chain_model.hpp"
+
+// Own namespace: the test files may be compiled together in one unity translation unit.
+namespace test_hard_cases {
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+/// Largest of |x| over a run.
+struct Largest {
+  double value = 0.0;
+  void add(double x) { value = std::max(value, std::abs(x)); }
+};
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Bricard's linkage
+// ------------------------------------------------------------------------------------------
+
+namespace {
+
+struct BricardRun {
+  std::size_t reported = 0;       // redundant equations reported by the run
+  int min_deficiency = 100, max_deficiency = -1;  // rank deficiency of Phi_q by SVD, per output
+  double phi = 0.0;               // max |Phi|
+  double energy_error = 0.0;      // max |E - E0| / (m g L)
+  double force_mismatch = 0.0;    // max |Phi_q^T lambda - (Q - M v')| / |Q - M v'|
+  double null_at_start = 0.0;     // |N^T lambda| / |lambda| at t = 0
+  double null_later = 0.0;        // the same, largest over the run
+  double drop = 0.0;              // lowest z of bar 1's centre of mass
+  long steps = 0;
+};
+
+BricardRun run_bricard(double step, double t_end) {
+  const bricard::Parameters p;
+  bricard::Linkage l = bricard::build(p);
+  const auto& model = l.model;
+  odyn::Workspace<bricard::Model> ws(model);
+  odyn::DynamicsSettings settings;
+  settings.step = step;
+  settings.t_end = t_end;
+  settings.output_interval = 0.01;
+  BricardRun run;
+  double energy0 = 0.0;
+  const auto summary = odyn::simulate(model, ws, settings, [&](const auto& w) {
+    // Energy and the applied and gyroscopic forces Q, written out from q and v.
+    double energy = 0.0;
+    Eigen::VectorXd force(model.num_velocities());
+    for (int b = 1; b <= model.num_bodies(); ++b) {
+      const auto& body = model.body(odyn::BodyId{b});
+      const auto x = w.q.template segment<3>(7 * (b - 1));
+      const auto xd = w.v.template segment<3>(6 * (b - 1));
+      const Eigen::Vector3d omega = w.v.template segment<3>(6 * (b - 1) + 3);
+      energy += 0.5 * body.mass * xd.squaredNorm() + 0.5 * omega.dot(body.inertia * omega) -
+                body.mass * p.gravity.dot(x);
+      force.segment<3>(6 * (b - 1)) = body.mass * p.gravity;
+      force.segment<3>(6 * (b - 1) + 3) = -omega.cross(body.inertia * omega);
+    }
+    if (w.t == 0.0) energy0 = energy;
+    run.energy_error =
+        std::max(run.energy_error, std::abs(energy - energy0) / (p.mass * 9.81 * p.length));
+    Eigen::VectorXd inertial(model.num_velocities());
+    for (int b = 1; b <= model.num_bodies(); ++b)
+      inertial.segment<6>(6 * (b - 1)) =
+          model.body(odyn::BodyId{b}).mass_block() * w.vdot.template segment<6>(6 * (b - 1));
+    const Eigen::VectorXd constraint_force = force - inertial;  // = Phi_q^T lambda
+    // Rank and null space of Phi_q^T by SVD.
+    const Eigen::MatrixXd jacobian = odyn::detail::dense_jacobian(model, w);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian.transpose(), Eigen::ComputeFullV);
+    const auto& sigma = svd.singularValues();
+    int rank = 0;
+    for (Eigen::Index i = 0; i < sigma.size(); ++i) rank += sigma[i] > 1e-9 * sigma[0] ? 1 : 0;
+    const int deficiency = static_cast<int>(jacobian.rows()) - rank;
+    run.min_deficiency = std::min(run.min_deficiency, deficiency);
+    run.max_deficiency = std::max(run.max_deficiency, deficiency);
+    const Eigen::MatrixXd null_space = svd.matrixV().rightCols(jacobian.rows() - rank);
+    const double null_part = (null_space.transpose() * w.lambda).norm() / w.lambda.norm();
+    if (w.t == 0.0) run.null_at_start = null_part;
+    run.null_later = std::max(run.null_later, null_part);
+    run.force_mismatch =
+        std::max(run.force_mismatch, (jacobian.transpose() * w.lambda - constraint_force).norm() /
+                                         constraint_force.norm());
+    run.phi = std::max(run.phi, w.phi.cwiseAbs().maxCoeff());
+    run.drop = std::min(run.drop, w.q[2]);
+  });
+  run.reported = summary.redundant_equations.size();
+  run.steps = summary.statistics.steps;
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("Bricard's linkage: redundant constraints, reported, and it moves", "[hard][bricard]") {
+  // Released at rest under gravity, the linkage folds down and swings back in 1.1 s. Grubler
+  // says 0 degrees of freedom, yet it has one: one of the 30 equations is redundant everywhere.
+  const BricardRun coarse = run_bricard(2e-3, 1.1);
+  const BricardRun fine = run_bricard(1e-3, 1.1);
+  INFO("redundant equations reported " << fine.reported << ", SVD rank deficiency "
+                                       << fine.min_deficiency << ".." << fine.max_deficiency);
+  INFO("max |Phi| " << fine.phi << "; energy error / (m g L): " << coarse.energy_error
+                    << " at h = 2e-3, " << fine.energy_error << " at h = 1e-3");
+  INFO("Phi_q^T lambda against Q - M v': " << fine.force_mismatch
+                                           << "; null-space part of lambda at t = 0: "
+                                           << fine.null_at_start << ", later up to "
+                                           << fine.null_later);
+  CHECK(fine.reported == 1);
+  CHECK(fine.min_deficiency == 1);
+  CHECK(fine.max_deficiency == 1);
+  CHECK(fine.drop < -0.4);  // it really moved: bar 1 swings 0.48 m down
+  CHECK(fine.phi < 1e-10);
+  // Energy is conserved up to the integrator's O(h^2) error (no drift: the error comes back to
+  // zero each swing); it falls by ~4 when h halves.
+  CHECK(fine.energy_error < 1e-4);
+  CHECK(coarse.energy_error / fine.energy_error > 3.5);
+  CHECK(coarse.energy_error / fine.energy_error < 4.5);
+  // The multipliers carry exactly the constraint forces Q - M v' (to Newton's tolerance).
+  CHECK(fine.force_mismatch < 1e-7);
+  // At the assembled state (solved outright, not by Newton corrections) lambda is the
+  // minimum-norm one: orthogonal to the null space of Phi_q^T.
+  CHECK(fine.null_at_start < 1e-10);
+}
+
+// ------------------------------------------------------------------------------------------
+// Four-bars: a parallelogram through its change points, and a linkage that locks
+// ------------------------------------------------------------------------------------------
+
+TEST_CASE("Parallelogram four-bar driven through its change points stays on its branch",
+          "[hard][four-bar]") {
+  // Crank and rocker 0.15 m, ground and coupler 0.40 m, the crank driven at one turn per second
+  // for three turns: six change points (all links in line), where the anti-parallelogram branch
+  // crosses. On the parallelogram branch the rocker angle equals the crank angle and the coupler
+  // translates: its angle stays 0.
+  // The steps straddle the change points (a step ending exactly on one meets a singular
+  // Jacobian there, and Newton's convergence slows to linear).
+  parallelogram::Parameters p;
+  const double h = 1e-3;
+  parallelogram::Linkage l = parallelogram::build(p);
+  odyn::Workspace<parallelogram::Model> ws(l.model);
+  odyn::DynamicsSettings settings;
+  settings.step = h;
+  settings.output_interval = h;
+  settings.t_end = 3.0;
+  Largest branch, coupler, crank, phi;
+  int change_points = 0;
+  double previous_turns = 0.0;
+  const auto summary = odyn::simulate(l.model, ws, settings, [&](const auto& w) {
+    const double crank_angle = w.q[3 * (l.crank.index - 1) + 2];
+    const double coupler_angle = w.q[3 * (l.coupler.index - 1) + 2];
+    const double rocker_angle = w.q[3 * (l.rocker.index - 1) + 2];
+    crank.add(crank_angle - (p.crank_angle + p.speed * w.t));
+    branch.add(rocker_angle - crank_angle);
+    coupler.add(coupler_angle);
+    phi.add(w.phi.cwiseAbs().maxCoeff());
+    const double turns = std::floor(crank_angle / pi + 1e-9);
+    if (w.t > 0.0 && turns > previous_turns) ++change_points;
+    previous_turns = turns;
+  });
+  INFO("rocker - crank angle " << branch.value << " rad, coupler angle " << coupler.value
+                               << " rad, crank " << crank.value << " rad, |Phi| " << phi.value
+                               << ", change points " << change_points << ", Newton iterations "
+                               << summary.statistics.newton_iterations << " in "
+                               << summary.statistics.steps << " steps");
+  CHECK(change_points == 6);
+  CHECK(summary.redundant_equations.empty());
+  CHECK(crank.value < 1e-9);
+  CHECK(branch.value < 1e-8);
+  CHECK(coupler.value < 1e-8);
+  CHECK(phi.value < 1e-10);
+}
+
+TEST_CASE("A rocker driven through a full turn locks at its dead point: a clear error",
+          "[hard][four-bar][errors]") {
+  // A crank-rocker (ground 0.40, crank 0.10, coupler 0.35, rocker 0.30 m) with the motor on the
+  // rocker's pivot, at 1 rad/s. The rocker can only swing: when B comes within coupler - crank
+  // = 0.25 m of O2, the crank and the coupler lie in line and no pose satisfies the motor.
+  parallelogram::Parameters p;
+  p.ground = 0.40, p.crank = 0.10, p.coupler = 0.35, p.rocker = 0.30;
+  p.crank_angle = 0.0;
+  p.driven = parallelogram::Pivot::o4;
+  p.speed = 1.0;
+  parallelogram::Linkage l = parallelogram::build(p);
+  // The dead point, from the geometry: |B - O2|^2 = ground^2 + rocker^2 + 2 ground rocker cos(phi)
+  // = (coupler - crank)^2 for the rocker angle phi.
+  const Eigen::Vector2d b0 = parallelogram::point_b(p, 0.0);
+  const double phi0 = std::atan2(b0.y(), b0.x() - p.ground);
+  const double reach = p.coupler - p.crank;
+  const double phi_dead =
+      std::acos((reach * reach - p.ground * p.ground - p.rocker * p.rocker) /
+                (2.0 * p.ground * p.rocker));
+  const double t_dead = (phi_dead - phi0) / p.speed;
+  REQUIRE(t_dead > 0.1);
+  odyn::Workspace<parallelogram::Model> ws(l.model);
+  odyn::DynamicsSettings settings;
+  settings.step = 1e-3;
+  settings.output_interval = 1e-2;
+  settings.t_end = 2.0;
+  double last_output = -1.0;
+  try {
+    odyn::simulate(l.model, ws, settings, [&](const auto& w) { last_output = w.t; });
+    FAIL("the driver turned the rocker past its dead point");
+  } catch (const odyn::SolverError& e) {
+    const std::string message = e.what();
+    INFO(message << "\ndead point at t = " << t_dead << " s");
+    CHECK(e.time() >= t_dead);
+    CHECK(e.time() <= t_dead + 2.0 * settings.step);
+    CHECK_THAT(message, Catch::Contains("t = ") && Catch::Contains("locked or singular"));
+    // It names the joint with the largest residual, one of the loop's.
+    const bool names_a_joint = message.find("'O2'") != std::string::npos ||
+                               message.find("'A'") != std::string::npos ||
+                               message.find("'B'") != std::string::npos ||
+                               message.find("'O4'") != std::string::npos ||
+                               message.find("'motor O4'") != std::string::npos;
+    CHECK(names_a_joint);
+  }
+  // The run stopped at the last good state: finite, before the dead point.
+  CHECK(last_output <= t_dead);
+  CHECK(last_output > t_dead - settings.output_interval - 1e-12);
+  CHECK(ws.q.allFinite());
+  CHECK(ws.lambda.allFinite());
+}
+
+// ------------------------------------------------------------------------------------------
+// The heavy top
+// ------------------------------------------------------------------------------------------
+
+namespace {
+
+/// The heavy top about its fixed point, integrated by classical RK4 in the body angular
+/// velocity and the orientation quaternion (normalized after each step):
+///   J_O w' = -w x J_O w + c x (R^T m g),   q' = q (0, w) / 2.
+Eigen::Quaterniond heavy_top_reference(const heavy_top::Parameters& p, double t_end,
+                                       double step) {
+  using Eigen::Matrix3d;
+  using Eigen::Quaterniond;
+  using Eigen::Vector3d;
+  const Vector3d& c = p.centre;
+  const Matrix3d j = Matrix3d(p.inertia.asDiagonal()) +
+                     p.mass * (c.squaredNorm() * Matrix3d::Identity() - c * c.transpose());
+  const Matrix3d j_inverse = j.inverse();
+  struct State {
+    Eigen::Vector4d q;  // w, x, y, z
+    Vector3d w;
+  };
+  auto rate = [&](const State& s) {
+    const Quaterniond q(s.q[0], s.q[1], s.q[2], s.q[3]);
+    const Vector3d torque = c.cross(q.conjugate() * (p.mass * p.gravity));
+    State d;
+    d.w = j_inverse * (torque - s.w.cross(j * s.w));
+    const Quaterniond dq = q * Quaterniond(0.0, s.w.x(), s.w.y(), s.w.z());
+    d.q = 0.5 * Eigen::Vector4d(dq.w(), dq.x(), dq.y(), dq.z());
+    return d;
+  };
+  auto plus = [](const State& s, double a, const State& d) {
+    return State{s.q + a * d.q, s.w + a * d.w};
+  };
+  State s{Eigen::Vector4d(1.0, 0.0, 0.0, 0.0), p.angular_velocity};
+  const long steps = std::lround(t_end / step);
+  const double h = t_end / static_cast<double>(steps);
+  for (long k = 0; k < steps; ++k) {
+    const State k1 = rate(s), k2 = rate(plus(s, 0.5 * h, k1)), k3 = rate(plus(s, 0.5 * h, k2)),
+                k4 = rate(plus(s, h, k3));
+    s.q += h / 6.0 * (k1.q + 2.0 * k2.q + 2.0 * k3.q + k4.q);
+    s.w += h / 6.0 * (k1.w + 2.0 * k2.w + 2.0 * k3.w + k4.w);
+    s.q.normalize();
+  }
+  return Quaterniond(s.q[0], s.q[1], s.q[2], s.q[3]);
+}
+
+struct TopRun {
+  double orientation_error = 0.0;  // rad, at t_end, against the reference
+  double energy = 0.0;             // max |E - E0| / E0
+  double momentum = 0.0;           // max |L_z - L_z0| / |L0|
+  double spin = 0.0;               // max |w_y - w_y0| / w_y0
+  double phi = 0.0;
+};
+
+TopRun run_heavy_top(double step, double t_end, const Eigen::Quaterniond& reference) {
+  const heavy_top::Parameters p;
+  heavy_top::Top top = heavy_top::build(p);
+  odyn::Workspace<heavy_top::Model> ws(top.model);
+  odyn::DynamicsSettings settings;
+  settings.step = step;
+  settings.t_end = t_end;
+  settings.output_interval = 0.01;
+  settings.generalized_alpha.rho_inf = 0.9;
+  const Eigen::Matrix3d j_centre = p.inertia.asDiagonal();
+  TopRun run;
+  double energy0 = 0.0, lz0 = 0.0, l0 = 0.0;
+  odyn::simulate(top.model, ws, settings, [&](const auto& w) {
+    const Eigen::Vector3d x = w.q.template head<3>(), xd = w.v.template head<3>();
+    const Eigen::Vector3d omega = w.v.template segment<3>(3);
+    const Eigen::Quaterniond q(w.q[3], w.q[4], w.q[5], w.q[6]);
+    const double energy = 0.5 * p.mass * xd.squaredNorm() + 0.5 * omega.dot(j_centre * omega) -
+                          p.mass * p.gravity.dot(x);
+    // Angular momentum about the fixed point, global axes.
+    const Eigen::Vector3d l = p.mass * x.cross(xd) + q * (j_centre * omega);
+    if (w.t == 0.0) energy0 = energy, lz0 = l.z(), l0 = l.norm();
+    run.energy = std::max(run.energy, std::abs(energy - energy0) / std::abs(energy0));
+    run.momentum = std::max(run.momentum, std::abs(l.z() - lz0) / l0);
+    run.spin = std::max(run.spin,
+                        std::abs(omega.y() - p.angular_velocity.y()) / p.angular_velocity.y());
+    run.phi = std::max(run.phi, w.phi.cwiseAbs().maxCoeff());
+  });
+  const Eigen::Quaterniond q(ws.q[3], ws.q[4], ws.q[5], ws.q[6]);
+  run.orientation_error = reference.angularDistance(q.normalized());
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("Heavy top: conserved quantities, and second order on the rotation group",
+          "[hard][heavy-top]") {
+  // m = 15 kg, J = diag(0.234375, 0.46875, 0.234375) kg m^2, centre of mass 1 m along the body
+  // y axis from the pivot, spinning at 150 rad/s about it (rho_inf 0.9, see README).
+  const double t_end = 0.5;
+  const Eigen::Quaterniond reference = heavy_top_reference(heavy_top::Parameters{}, t_end, 1e-5);
+  // The reference at half its step agrees to far below the errors measured here.
+  CHECK(reference.angularDistance(heavy_top_reference(heavy_top::Parameters{}, t_end, 5e-6)) <
+        1e-10);
+  const std::vector<double> steps{4e-4, 2e-4, 1e-4};
+  std::vector<TopRun> runs;
+  for (const double h : steps) runs.push_back(run_heavy_top(h, t_end, reference));
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const TopRun& r = runs[i];
+    INFO("h = " << steps[i] << ": orientation error " << r.orientation_error << " rad, energy "
+                << r.energy << ", L_z " << r.momentum << ", Omega_y " << r.spin << ", |Phi| "
+                << r.phi);
+    CHECK(r.phi < 1e-10);
+    CHECK(r.orientation_error < 2e-2);
+    if (i == 0) continue;
+    const TopRun& coarse = runs[i - 1];
+    const double order = std::log2(coarse.orientation_error / r.orientation_error);
+    INFO("observed order " << order);
+    CHECK(order > 1.8);
+    CHECK(order < 2.3);
+    // The conserved quantities hold to errors that fall with h (at second order, or they sit
+    // at rounding level already).
+    auto falls = [](double coarse_error, double fine_error, double floor) {
+      return fine_error < floor || coarse_error / fine_error > 3.0;
+    };
+    CHECK(falls(coarse.energy, r.energy, 1e-12));
+    CHECK(falls(coarse.momentum, r.momentum, 1e-12));
+    CHECK(falls(coarse.spin, r.spin, 1e-12));
+  }
+  CHECK(runs.back().energy < 1e-4);
+  CHECK(runs.back().momentum < 1e-4);
+  CHECK(runs.back().spin < 1e-4);
+}
+
+// ------------------------------------------------------------------------------------------
+// A stiff spring-mass chain
+// ------------------------------------------------------------------------------------------
+
+TEST_CASE("Stiff chain: stable far beyond the explicit limit, fast mode damped by rho_inf",
+          "[hard][stiff]") {
+  // Blocks of 1 kg: ground -(100 N/m)- block 1 -(1e8 N/m)- block 2. Modes (M = I): the
+  // eigenpairs of K = [k1 + k2, -k2; -k2, k2], written out for a symmetric 2 x 2.
+  stiff_chain::Parameters p;
+  p.displacement1 = 0.1;
+  // The fast mode's share: small, because the first predictor moves a stiff mode by
+  // (omega h)^2 / 2 times its displacement (here 1e4 x), and it must stay well below the
+  // spacing of the blocks, or the spring would be pushed through zero length.
+  p.displacement2 = 0.1 + 1e-5;
+  const double k11 = p.soft + p.stiff, k12 = -p.stiff, k22 = p.stiff;
+  const double mean = 0.5 * (k11 + k22), half_gap = std::hypot(0.5 * (k11 - k22), k12);
+  const double omega_slow = std::sqrt((mean - half_gap) / p.mass);
+  const double omega_fast = std::sqrt((mean + half_gap) / p.mass);
+  auto mode = [&](double lambda) {  // unit eigenvector of K for eigenvalue lambda
+    return Eigen::Vector2d(-k12, k11 - lambda).normalized();
+  };
+  const Eigen::Vector2d slow = mode(mean - half_gap) / std::sqrt(p.mass);
+  const Eigen::Vector2d fast = mode(mean + half_gap) / std::sqrt(p.mass);
+  const Eigen::Vector2d u0(p.displacement1, p.displacement2);
+  const double slow0 = slow.dot(p.mass * u0);  // modal coordinates (mass-normalized modes)
+  const double h = 1e-2;
+  INFO("omega " << omega_slow << " and " << omega_fast << " rad/s; h omega_max = "
+                << h * omega_fast << ", h / (2 / omega_max) = " << h * omega_fast / 2.0);
+  REQUIRE(h * omega_fast > 100.0);
+
+  for (const double rho : {0.9, 0.6}) {
+    stiff_chain::Chain chain = stiff_chain::build(p);
+    odyn::Workspace<stiff_chain::Model> ws(chain.model);
+    odyn::DynamicsSettings settings;
+    settings.step = h;
+    settings.output_interval = h;
+    settings.t_end = 2.0;
+    settings.generalized_alpha.rho_inf = rho;
+    std::vector<double> amplitude;  // of the fast mode, per step
+    Largest slow_error, fast_displacement;
+    odyn::simulate(chain.model, ws, settings, [&](const auto& w) {
+      const Eigen::Vector2d u(w.q[0] - p.spacing, w.q[3] - 2.0 * p.spacing);
+      const Eigen::Vector2d v(w.v[0], w.v[3]);
+      const double eta = fast.dot(p.mass * u), eta_dot = fast.dot(p.mass * v);
+      amplitude.push_back(std::hypot(eta, eta_dot / omega_fast));
+      fast_displacement.add(eta);
+      // The slow mode against its exact solution, released at rest.
+      slow_error.add(slow.dot(p.mass * u) - slow0 * std::cos(omega_slow * w.t));
+    });
+    // The decay per step, once the start-up transient of the (near-triple) root has passed.
+    const std::size_t from = rho > 0.8 ? 30 : 10, to = rho > 0.8 ? 60 : 30;
+    const double decay =
+        std::pow(amplitude[to] / amplitude[from], 1.0 / static_cast<double>(to - from));
+    INFO("rho_inf " << rho << ": fast-mode decay per step " << decay << " (steps " << from
+                    << " to " << to << "), amplitude " << amplitude.front() << " -> "
+                    << amplitude.back() << ", slow-mode error " << slow_error.value << " of "
+                    << slow0);
+    CHECK(std::abs(decay - rho) < 0.025);
+    CHECK(amplitude.back() < 1e-6 * amplitude.front());  // stable and damped out
+    CHECK(fast_displacement.value < 2.0 * std::abs(fast.dot(p.mass * u0)));
+    // The slow mode: generalized-alpha's phase error (omega h)^2 / 12 per radian gives
+    // 5.9e-3 rad over 2 s, 8.3e-4 m on 0.14 m.
+    CHECK(slow_error.value < 1.2e-3);
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// An undamped double pendulum over 1000 s
+// ------------------------------------------------------------------------------------------
+
+TEST_CASE("Double pendulum over 1000 s: energy and constraints do not drift", "[hard][long]") {
+  // Two 1 m, 1 kg bars released at 1 and 2 rad from the vertical: chaotic. 400 000 steps.
+  const double_pendulum::Parameters p;
+  double_pendulum::Pendulum d = double_pendulum::build(p);
+  odyn::Workspace<double_pendulum::Model> ws(d.model);
+  odyn::DynamicsSettings settings;
+  settings.step = 2.5e-3;
+  settings.output_interval = 0.5;
+  settings.t_end = 1000.0;
+  const double scale = p.mass * p.g * p.length;
+  double energy0 = 0.0, first_mean = 0.0, last_mean = 0.0;
+  int first_count = 0, last_count = 0;
+  Largest energy, phi, velocity, gap;
+  const auto summary = odyn::simulate(d.model, ws, settings, [&](const auto& w) {
+    // Energy written out from q and v: bars' kinetic energy and height of their centres.
+    double e = 0.0;
+    for (int b = 0; b < 2; ++b)
+      e += 0.5 * p.mass * w.v.template segment<2>(3 * b).squaredNorm() +
+           0.5 * (p.mass * p.length * p.length / 12.0) * w.v[3 * b + 2] * w.v[3 * b + 2] +
+           p.mass * p.g * w.q[3 * b + 1];
+    if (w.t == 0.0) energy0 = e;
+    energy.add((e - energy0) / scale);
+    if (w.t <= 100.0) first_mean += (e - energy0) / scale, ++first_count;
+    if (w.t >= 900.0) last_mean += (e - energy0) / scale, ++last_count;
+    const auto [phi_norm, velocity_norm] = odyn::constraint_residuals(d.model, w);
+    phi.add(phi_norm);
+    velocity.add(velocity_norm);
+    // The pins from q: the upper bar's top at the origin, its bottom on the lower bar's top.
+    const Eigen::Vector2d e1(std::cos(w.q[2]), std::sin(w.q[2]));
+    const Eigen::Vector2d e2(std::cos(w.q[5]), std::sin(w.q[5]));
+    const Eigen::Vector2d x1 = w.q.template segment<2>(0), x2 = w.q.template segment<2>(3);
+    gap.add(std::max((x1 - 0.5 * p.length * e1).norm(),
+                     (x1 + 0.5 * p.length * e1 - x2 + 0.5 * p.length * e2).norm()));
+  });
+  first_mean /= first_count;
+  last_mean /= last_count;
+  INFO("1000 s at h = " << settings.step << " (" << summary.statistics.steps << " steps, "
+                        << summary.wall_seconds << " s): max |E - E0| / (m g l) = "
+                        << energy.value << ", mean over the first 100 s " << first_mean
+                        << ", over the last 100 s " << last_mean << "; max |Phi| " << phi.value
+                        << ", max |Phi_q v| " << velocity.value << ", pin gap " << gap.value
+                        << " m");
+  // Bounded, not drifting: generalized-alpha's O(h^2) energy error oscillates with the motion;
+  // its numerical damping (rho_inf 0.9) acts on the high frequencies only.
+  CHECK(energy.value < 5e-3);
+  CHECK(std::abs(last_mean - first_mean) < 2e-3);
+  CHECK(phi.value < 1e-10);
+  CHECK(gap.value < 1e-10);
+  // Index 3: the velocity constraints hold only to the integrator's O(h^2), but stay bounded.
+  CHECK(velocity.value < 2e-3);
+}
+
+}  // namespace test_hard_cases
