@@ -15,11 +15,18 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa: E402
 
 ERROR_LABELS = {
     "engine": "|theta(1) error| [rad]",
     "engine-planar": "|theta(1) error| [rad]",
     "andrews": "largest relative error of the 7 angles at t = 0.03",
+}
+# The targets: (error, CPU milliseconds), drawn as a box to reach into.
+TARGETS = {
+    "engine": (1e-7, 10.0),
+    "engine-planar": (1e-7, 10.0),
+    "andrews": (1e-10, 50.0),
 }
 TITLES = {
     "engine": "Engine (spatial, 18 coordinates), 1 s",
@@ -48,6 +55,14 @@ def plot(case: str, families: dict[str, list[tuple[float, float, float]]], out: 
         runs.sort()
         ax.loglog([1e3 * c for c, _, _ in runs], [e for _, e, _ in runs], "o-", label=family,
                   markersize=4)
+    if case in TARGETS:
+        error, milliseconds = TARGETS[case]
+        ax.axhline(error, color="grey", linestyle="--", linewidth=0.8)
+        ax.axvline(milliseconds, color="grey", linestyle="--", linewidth=0.8)
+        ax.text(milliseconds, error, " target", color="grey", fontsize=8, va="top")
+    ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("CPU time of the run [ms]")
     ax.set_ylabel(ERROR_LABELS.get(case, "error"))
     ax.set_title(TITLES.get(case, case))
