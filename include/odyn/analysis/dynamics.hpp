@@ -67,9 +67,14 @@ namespace detail {
 /// A step of size h from the committed state has just carried an element's event function from
 /// g_start < 0 to g_end >= 0. Cuts the step back to end on the switch (the Illinois variant of
 /// regula falsi on the step size), commits it and restarts the integrator under the new law.
-template <class Model, class Integrator>
-void end_step_on_switch(const Model& model, Workspace<Model>& ws, Integrator& integrator, double h,
-                        double g_start, double g_end, double event_time_tolerance) {
+/// `before_commit()` runs on the final trial state, just before it is committed. With
+/// `from_dense_output`, the bracketing probes the attempted step's interpolant (positions
+/// only) instead of attempting shorter steps: one step attempt per event instead of ten.
+template <class Model, class Integrator, class BeforeCommit = void (*)()>
+void end_step_on_switch(
+    const Model& model, Workspace<Model>& ws, Integrator& integrator, double h, double g_start,
+    double g_end, double event_time_tolerance, BeforeCommit&& before_commit = [] {},
+    bool from_dense_output = false) {
   // Bracket [lo, hi] on the step size with g(lo) < 0 <= g(hi). Trials stay a little longer
   // than nothing: an index-3 step of a few femtoseconds turns the rounding in Phi into large
   // velocity errors (the switch is then located to within min_trial).
@@ -81,7 +86,14 @@ void end_step_on_switch(const Model& model, Workspace<Model>& ws, Integrator& in
     if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
     trial = std::max(trial, min_trial);
     if (trial >= hi) break;
-    if (!integrator.attempt(trial)) integrator.fail();
+    if constexpr (DenseOutputIntegrator<Integrator>) {
+      if (from_dense_output)
+        integrator.interpolate_frames(integrator.time() + trial);
+      else if (!integrator.attempt(trial))
+        integrator.fail();
+    } else if (!integrator.attempt(trial)) {
+      integrator.fail();
+    }
     const double g = event_function(model, ws);
     if (g >= 0.0) {
       hi = trial, g_hi = g;
@@ -102,6 +114,7 @@ void end_step_on_switch(const Model& model, Workspace<Model>& ws, Integrator& in
     if (event_function(model, ws) >= 0.0 || extension == 10 || end >= h) break;
     end = std::min(h, end + std::ldexp(min_trial, extension));
   }
+  before_commit();
   integrator.commit();
   integrator.restart();
   integrator.count_event();
@@ -155,6 +168,64 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
       }
     }
     integrator.commit();
+  }
+}
+
+/// Advances an adaptive integrator with dense output (interpolate, restore_trial) from its time
+/// t0 through `outputs` output times t0 + k dt, stepping as its error control proposes: outputs
+/// inside a step are interpolated (so they do not cut the steps), and `record()` sees each one
+/// with the stateful elements advanced to it. Ends exactly at the last output time; events as
+/// in advance_to.
+template <class Model, DenseOutputIntegrator Integrator, class Record>
+void advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integrator& integrator,
+                               double output_interval, long outputs, Record&& record,
+                               double event_time_tolerance = 1e-12) {
+  const double t0 = integrator.time();
+  const auto output_time = [&](long k) { return t0 + static_cast<double>(k) * output_interval; };
+  const double t_end = output_time(outputs);
+  const double time_tolerance = 1e-12 * std::max(1.0, std::abs(t_end));
+  auto saved_states = ws.states;  // sized once: the copies below allocate nothing
+  long k = 1;
+  // Hands over every output time up to the trial state now in the workspace, then puts the
+  // trial state back for its commit.
+  const auto emit = [&] {
+    const double trial_end = ws.t;
+    bool interpolated = false;
+    for (; k <= outputs && output_time(k) <= trial_end + time_tolerance; ++k) {
+      if (output_time(k) < trial_end - time_tolerance) {
+        if (!integrator.interpolate(output_time(k))) integrator.fail();
+        interpolated = true;
+      } else if (interpolated) {  // the output is the trial state itself
+        integrator.restore_trial();
+        interpolated = false;
+      }
+      saved_states = ws.states;
+      advance_states(model, ws);  // as if a step ended here
+      record();
+      ws.states = saved_states;
+    }
+    if (interpolated) integrator.restore_trial();
+  };
+  while (k <= outputs) {
+    const double remaining = t_end - integrator.time();
+    double h = std::min(integrator.proposed_step(), remaining);
+    if (h < remaining && h > 0.5 * remaining) h = 0.5 * remaining;  // no sliver before the end
+    double g_start = 0.0;
+    if constexpr (has_events<Model>()) g_start = event_function(model, ws);
+    if (!integrator.attempt(h) || !(integrator.error_norm() <= 1.0)) {
+      integrator.reject();
+      continue;
+    }
+    if constexpr (has_events<Model>()) {
+      const double g_end = event_function(model, ws);
+      if (g_end >= 0.0 && g_start < 0.0) {
+        detail::end_step_on_switch(model, ws, integrator, h, g_start, g_end, event_time_tolerance,
+                                   emit, true);
+        continue;
+      }
+    }
+    emit();
+    integrator.accept();
   }
 }
 
@@ -231,7 +302,11 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   record();
   const double t0 = ws.t;
   const long outputs = static_cast<long>(std::floor((s.t_end - t0) / s.output_interval + 1e-9));
-  for (long k = 1; k <= outputs; ++k) {
+  bool dense = false;
+  if constexpr (DenseOutputIntegrator<Integrator>) dense = integrator.adaptive();
+  if constexpr (DenseOutputIntegrator<Integrator>)
+    if (dense) advance_with_dense_output(model, ws, integrator, s.output_interval, outputs, record);
+  for (long k = 1; k <= outputs && !dense; ++k) {
     advance_to(model, ws, integrator, t0 + static_cast<double>(k) * s.output_interval, s.step);
     record();
   }

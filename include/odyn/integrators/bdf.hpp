@@ -25,7 +25,7 @@
 // orders k-1 and k+1 from divided differences choose the order; the step doubles at most and
 // shrinks on rejection. A (re)start begins at order 1 with a step from an estimate of y'' and a
 // fictitious past value y_n - h y'_n; order and step then grow every step until the first
-// rejection.
+// rejection. Output times inside a step are interpolated by the step's BDF polynomial.
 //
 // K. E. Brenan, S. L. Campbell, L. R. Petzold, "Numerical Solution of Initial-Value Problems in
 // Differential-Algebraic Equations", SIAM 1996, Ch. 3 and 5 (DASSL); C. W. Gear, B. Leimkuhler,
@@ -118,6 +118,11 @@ class Bdf {
     lambda_n_ = ws.lambda;
     solver_.analyze(model);
     projector_.analyze(model);
+    output_solver_.analyze(model);
+    q_trial_ = ws.q;
+    v_trial_ = ws.v;
+    vdot_trial_ = ws.vdot;
+    lambda_trial_ = ws.lambda;
     initialize();
   }
 
@@ -143,6 +148,10 @@ class Bdf {
       if (solve_step(t_n_ + h)) {
         newton_failed_ = false;
         estimate_error();
+        q_trial_ = ws_.q;
+        v_trial_ = ws_.v;
+        vdot_trial_ = ws_.vdot;
+        lambda_trial_ = ws_.lambda;
         return std::isfinite(error_);
       }
       factorized_ = false;  // a stale matrix may be the cause: once more with a fresh one
@@ -153,6 +162,80 @@ class Bdf {
 
   /// Local error of the last attempt in units of the tolerance (accept when <= 1).
   double error_norm() const { return error_; }
+
+  /// The state at t within the last attempted step from the BDF polynomial of its order
+  /// (through the trial value and the k last ones), projected onto the constraints, with v'
+  /// and lambda there (a solver of its own, so the step's factorizations stay as they are).
+  bool interpolate(double t) {
+    interpolate_frames(t);
+    if (!output_solver_.factorize(model_, ws_, IterationFactors{})) return false;
+    ++statistics_.factorizations;
+    if (m_ > 0) {
+      // One correction of Phi in the mass metric, then of Phi_q v + Phi_t: the interpolant is
+      // off the constraints by the local error only.
+      rhs_.head(nv_total_).setZero();
+      rhs_.tail(m_) = -ws_.phi;
+      output_solver_.solve(rhs_, solution_);
+      for (int b = 0; b < model_.num_bodies(); ++b)
+        Space::integrate(Eigen::Matrix<double, nq, 1>(ws_.q.template segment<nq>(b * nq)),
+                         solution_.template segment<nv>(b * nv),
+                         ws_.q.template segment<nq>(b * nq));
+      update_frames(model_, ws_);
+      evaluate_constraints(model_, ws_);
+      jacobian_times(model_, ws_, ws_.v, velocity_residual_);
+      rhs_.tail(m_) = -(velocity_residual_ + ws_.phi_t);
+      output_solver_.solve(rhs_, solution_);
+      ws_.v += solution_.head(nv_total_);
+      update_frames(model_, ws_);
+    }
+    evaluate_forces(model_, ws_);
+    evaluate_gamma(model_, ws_);
+    rhs_.head(nv_total_) = ws_.force;
+    rhs_.tail(m_) = ws_.gamma;
+    output_solver_.solve(rhs_, solution_);
+    ws_.vdot = solution_.head(nv_total_);
+    ws_.lambda = solution_.tail(m_);
+    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
+  }
+
+  /// Positions and velocities at t from the last attempt's polynomial, and the frames.
+  void interpolate_frames(double t) {
+    const int k = order_;
+    std::array<double, kHistory + 1> tau{};
+    tau[0] = t_n_ + h_;
+    for (int j = 1; j <= k; ++j) tau[j] = times_[j - 1];
+    scratch_.setZero();
+    for (int j = 0; j <= k; ++j) {
+      double weight = 1.0;
+      for (int i = 0; i <= k; ++i)
+        if (i != j) weight *= (t - tau[i]) / (tau[j] - tau[i]);
+      if (j == 0) {
+        scratch_.head(nq_total_) += weight * q_trial_;
+        scratch_.tail(nv_total_) += weight * v_trial_;
+      } else {
+        scratch_ += weight * history_[j - 1].head(ny_);
+      }
+    }
+    ws_.t = t;
+    ws_.q = scratch_.head(nq_total_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Space::normalize(ws_.q.template segment<nq>(b * nq));
+    ws_.v = scratch_.tail(nv_total_);
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+  }
+
+  /// Puts the last attempt's trial state back into the workspace (after interpolate()).
+  void restore_trial() {
+    ws_.t = t_n_ + h_;
+    ws_.q = q_trial_;
+    ws_.v = v_trial_;
+    ws_.vdot = vdot_trial_;
+    ws_.lambda = lambda_trial_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+  }
 
   /// Commits the last attempt and chooses the next order and step (Brenan et al., Sect. 5.2).
   void accept() {
@@ -578,6 +661,7 @@ class Bdf {
   StepControl control_;
   Solver solver_;     // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
   Solver projector_;  // [M, Phi_q^T; Phi_q, 0]
+  Solver output_solver_;  // the same matrix at interpolated output points
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, ny_ = 0;
   double t_n_ = 0.0, h_ = 0.0, c_ = 1.0, c_factorized_ = 1.0;
@@ -592,6 +676,7 @@ class Bdf {
   Eigen::VectorXd u_, dv_, du_;  // u = M^-1 Phi_q^T mu and the corrections
   Eigen::VectorXd rhs_, solution_, velocity_residual_;
   Eigen::VectorXd q_n_, v_n_, vdot_n_, lambda_n_;
+  Eigen::VectorXd q_trial_, v_trial_, vdot_trial_, lambda_trial_;  // the last attempt's end
 };
 
 }  // namespace odyn
