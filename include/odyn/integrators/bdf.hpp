@@ -43,6 +43,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/minimum_norm.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -310,6 +311,7 @@ class Bdf {
 
   /// Makes the trial state of the last attempt the committed one (no step-size change).
   void commit() {
+    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     y_new_ << ws_.q, ws_.v, ws_.lambda;
     push(y_new_, ws_.t);

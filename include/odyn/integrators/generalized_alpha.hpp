@@ -18,6 +18,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/minimum_norm.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -175,6 +176,7 @@ class GeneralizedAlpha {
 
   /// Accepts the trial state of the last successful attempt.
   void commit() {
+    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     a_previous_ = a_step_;
     a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) /

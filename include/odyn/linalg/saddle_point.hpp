@@ -189,7 +189,8 @@ class BlockSchurSaddlePoint {
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
     schur_llt_.compute(Eigen::MatrixXd::Identity(m_, m_));  // sizes it; info() defined
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
-    schur_eigen_ = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(m_);
+    // Sized (and its info() defined, which UBSan checks on copies) by a first computation.
+    if (m_ > 0) schur_eigen_.compute(Eigen::MatrixXd::Identity(m_, m_));
     inverse_eigenvalues_ = Eigen::VectorXd::Zero(m_);
     work_n_ = Eigen::VectorXd::Zero(n_);
     work_m_ = Eigen::VectorXd::Zero(m_);
