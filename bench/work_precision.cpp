@@ -85,7 +85,8 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
   std::vector<Setting> ladder;
   const std::vector<double> loose = {1e-3, 1e-4, 1e-5, 1e-6};
   const std::vector<double> tight = {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
-  for (double h : steps) ladder.push_back({"generalized-alpha, fixed h", "generalized-alpha", false, h});
+  for (double h : steps)
+    ladder.push_back({"generalized-alpha, fixed h", "generalized-alpha", false, h});
   for (double h : steps) ladder.push_back({"hht, fixed h", "hht", false, h});
   for (double tol : loose)
     ladder.push_back({"generalized-alpha, adaptive", "generalized-alpha", true, tol});
@@ -121,8 +122,8 @@ Case engine_case(const std::string& name, Build build, bool quick) {
     std::size_t k = 0;
     const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& state) {
       const auto& sample = reference.at(k++);
-      out.errors[1] = std::max(out.errors[1], std::abs(engine::piston_height(e, state) -
-                                                       sample.z_piston));
+      out.errors[1] =
+          std::max(out.errors[1], std::abs(engine::piston_height(e, state) - sample.z_piston));
       // The gas force jumps at ignition (2 pi) and exhaust opening (3 pi) in each 4 pi cycle.
       const double cycle = std::fmod(sample.theta, 4.0 * std::numbers::pi);
       const bool near_jump = std::abs(cycle - 2.0 * std::numbers::pi) < 1e-2 ||
@@ -157,13 +158,15 @@ Case andrews_case(bool quick) {
     const auto summary = odyn::simulate(m.model, ws, settings, [](const auto&) {});
     const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
     for (int i = 0; i < 7; ++i)
-      out.errors[0] = std::max(out.errors[0], std::abs(angles[i] - reference.angle[i]) /
-                                                  std::abs(reference.angle[i]));
+      out.errors[0] = std::max(
+          out.errors[0], std::abs(angles[i] - reference.angle[i]) / std::abs(reference.angle[i]));
     out.statistics = summary.statistics;
     out.max_phi = summary.max_position_residual;
     return out;
   };
-  return {"andrews", {"max relative angle error"}, run,
+  return {"andrews",
+          {"max relative angle error"},
+          run,
           standard_ladder({4e-6, 2e-6, 1e-6, 5e-7, 2.5e-7}, quick)};
 }
 
@@ -203,8 +206,10 @@ int main(int argc, char** argv) {
   }
 
   std::vector<Case> cases;
-  cases.push_back(engine_case("engine", [] { return engine::build(); }, quick));
-  cases.push_back(engine_case("engine-planar", [] { return engine::planar::build(); }, quick));
+  cases.push_back(engine_case(
+      "engine", [] { return engine::build(); }, quick));
+  cases.push_back(engine_case(
+      "engine-planar", [] { return engine::planar::build(); }, quick));
   cases.push_back(andrews_case(quick));
 
   std::ofstream csv(out_path);
@@ -219,8 +224,8 @@ int main(int argc, char** argv) {
     if (!chosen.empty() && std::find(chosen.begin(), chosen.end(), c.name) == chosen.end())
       continue;
     std::printf("\n== %s (error: %s)\n", c.name.c_str(), c.error_names.front().c_str());
-    std::printf("%-30s %10s %11s %11s %9s %8s %7s\n", "integrator", "h or tol", "error",
-                "CPU [ms]", "steps", "Newton", "rejected");
+    std::printf("%-30s %10s %11s %11s %9s %8s %7s\n", "integrator", "h or tol", "error", "CPU [ms]",
+                "steps", "Newton", "rejected");
     for (const Setting& s : c.ladder) {
       Outcome outcome;
       std::vector<double> times;
@@ -249,8 +254,8 @@ int main(int argc, char** argv) {
       const auto& st = outcome.statistics;
       csv << "," << cpu << "," << st.steps << "," << st.rejected_steps << ","
           << st.newton_iterations << "," << st.jacobian_evaluations << "," << st.factorizations
-          << "," << st.events << "," << outcome.max_phi << ","
-          << (outcome.failed ? "failed" : "ok") << "\n";
+          << "," << st.events << "," << outcome.max_phi << "," << (outcome.failed ? "failed" : "ok")
+          << "\n";
       std::fflush(stdout);
     }
   }

@@ -19,9 +19,9 @@ namespace sp = odyn::spatial;
 using Eigen::Vector3d;
 
 struct Parameters {
-  double length = 1.0;  // m, every link
-  double mass = 1.0;    // kg, every moving bar
-  double radius = 0.01;  // m, of the bars (their inertia about their own axis)
+  double length = 1.0;                // m, every link
+  double mass = 1.0;                  // kg, every moving bar
+  double radius = 0.01;               // m, of the bars (their inertia about their own axis)
   Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
 };
 
@@ -65,8 +65,8 @@ inline Linkage build(const Parameters& p = {}) {
     const odyn::BodyId b = i == 5 ? odyn::ground : l.bars[i];
     const Vector3d on_a = i == 0 ? v[0] : Vector3d(0.5 * (v[i] - v[i - 1]));
     const Vector3d on_b = i == 5 ? v[5] : Vector3d(0.5 * (v[i] - v[i + 1]));
-    l.joints[i] = l.model.add(sp::Revolute("J" + std::to_string(i + 1), a, {on_a, w[i]}, b,
-                                           {on_b, w[i]}));
+    l.joints[i] =
+        l.model.add(sp::Revolute("J" + std::to_string(i + 1), a, {on_a, w[i]}, b, {on_b, w[i]}));
   }
   l.model.add(sp::Gravity("gravity", p.gravity));
   return l;

@@ -14,7 +14,7 @@ namespace pl = odyn::planar;
 using Eigen::Vector2d;
 
 struct Parameters {
-  double mass = 1.0, length = 1.0;  // each bar; kg, m
+  double mass = 1.0, length = 1.0;    // each bar; kg, m
   double theta1 = 1.0, theta2 = 2.0;  // rad, from the downward vertical
   double g = 9.81;                    // m/s^2
 };

@@ -14,11 +14,11 @@ namespace sp = odyn::spatial;
 using Eigen::Vector3d;
 
 struct Parameters {
-  double mass = 15.0;                                  // kg
-  Vector3d inertia{0.234375, 0.46875, 0.234375};       // kg m^2, principal, about the centre
-  Vector3d centre{0.0, 1.0, 0.0};                      // m, body frame, from the pivot
-  Vector3d gravity{0.0, 0.0, -9.81};                   // m/s^2
-  Vector3d angular_velocity{0.0, 150.0, -4.61538};     // rad/s, body frame, initial
+  double mass = 15.0;                               // kg
+  Vector3d inertia{0.234375, 0.46875, 0.234375};    // kg m^2, principal, about the centre
+  Vector3d centre{0.0, 1.0, 0.0};                   // m, body frame, from the pivot
+  Vector3d gravity{0.0, 0.0, -9.81};                // m/s^2
+  Vector3d angular_velocity{0.0, 150.0, -4.61538};  // rad/s, body frame, initial
 };
 
 using Model = sp::Model<sp::Spherical, sp::Gravity>;
@@ -32,13 +32,13 @@ struct Top {
 inline Top build(const Parameters& p = {}) {
   Top t;
   // At the identity orientation the centre of mass is at `centre` and moves with w x centre.
-  t.body = t.model.add_body({.name = "top",
-                             .mass = p.mass,
-                             .inertia = sp::Body::principal(p.inertia.x(), p.inertia.y(),
-                                                            p.inertia.z()),
-                             .position = p.centre,
-                             .linear_velocity = p.angular_velocity.cross(p.centre),
-                             .angular_velocity = p.angular_velocity});
+  t.body =
+      t.model.add_body({.name = "top",
+                        .mass = p.mass,
+                        .inertia = sp::Body::principal(p.inertia.x(), p.inertia.y(), p.inertia.z()),
+                        .position = p.centre,
+                        .linear_velocity = p.angular_velocity.cross(p.centre),
+                        .angular_velocity = p.angular_velocity});
   t.pivot = t.model.add(sp::Spherical("pivot", odyn::ground, Vector3d::Zero(), t.body, -p.centre));
   t.model.add(sp::Gravity("gravity", p.gravity));
   return t;

@@ -25,8 +25,8 @@ enum class Pivot { o2, o4 };
 struct Parameters {
   double ground = 0.40, crank = 0.15, coupler = 0.40, rocker = 0.15;  // link lengths, m
   double crank_mass = 0.5, coupler_mass = 1.2, rocker_mass = 0.5;     // kg
-  double crank_angle = 0.5;               // rad, initial
-  double speed = 2.0 * std::numbers::pi;  // rad/s, of the driven pivot
+  double crank_angle = 0.5;                                           // rad, initial
+  double speed = 2.0 * std::numbers::pi;                              // rad/s, of the driven pivot
   Pivot driven = Pivot::o2;
   double g = 9.81;  // m/s^2, along -y
 };

@@ -14,12 +14,12 @@ namespace pl = odyn::planar;
 using Eigen::Vector2d;
 
 struct Parameters {
-  double mass = 1.0;          // kg, each block
-  double soft = 100.0;        // N/m, ground - block 1
-  double stiff = 1e8;         // N/m, block 1 - block 2
-  double spacing = 1.0;       // m, free length of each spring
-  double displacement1 = 0.0;  // m, initial, from rest
-  double displacement2 = 0.0;  // m
+  double mass = 1.0;                        // kg, each block
+  double soft = 100.0;                      // N/m, ground - block 1
+  double stiff = 1e8;                       // N/m, block 1 - block 2
+  double spacing = 1.0;                     // m, free length of each spring
+  double displacement1 = 0.0;               // m, initial, from rest
+  double displacement2 = 0.0;               // m
   double velocity1 = 0.0, velocity2 = 0.0;  // m/s, initial
 };
 

@@ -41,7 +41,8 @@ double andrews_error(double tolerance, odyn::RunSummary* summary = nullptr) {
   const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
   double error = 0.0;
   for (int i = 0; i < 7; ++i)
-    error = std::max(error, std::abs(angles[i] - reference.angle[i]) / std::abs(reference.angle[i]));
+    error =
+        std::max(error, std::abs(angles[i] - reference.angle[i]) / std::abs(reference.angle[i]));
   return error;
 }
 
@@ -89,7 +90,8 @@ double stiff_run(const std::string& integrator, double tolerance, odyn::RunSumma
   settings.output_interval = 0.1;
   double error = 0.0;
   summary = odyn::simulate(s.model, ws, settings, [&](const auto& state) {
-    error = std::max(error, std::abs(state.frames[s.slider.index].position.x() - Stiff::exact(state.t)));
+    error = std::max(error,
+                     std::abs(state.frames[s.slider.index].position.x() - Stiff::exact(state.t)));
   });
   return error;
 }
@@ -131,10 +133,9 @@ TEST_CASE("bdf: the engine through its switches", "[bdf][engine]") {
           std::max(z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
     });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
-    INFO("tolerance " << tolerance << ": theta error " << theta_error << " rad, z error "
-                      << z_error << " m, steps " << summary.statistics.steps << ", rejected "
-                      << summary.statistics.rejected_steps << ", "
-                      << summary.wall_seconds << " s");
+    INFO("tolerance " << tolerance << ": theta error " << theta_error << " rad, z error " << z_error
+                      << " m, steps " << summary.statistics.steps << ", rejected "
+                      << summary.statistics.rejected_steps << ", " << summary.wall_seconds << " s");
     CHECK(theta_error < theta_bound);
     CHECK(z_error < z_bound);
     const long events = static_cast<long>(std::floor(reference.back().theta / std::numbers::pi));
@@ -189,8 +190,8 @@ TEST_CASE("bdf: heavy symmetric top in steady precession", "[bdf][pendulums]") {
     if (w.t > 0.0) azimuth += std::remainder(angle - previous, 2.0 * std::numbers::pi);
     previous = angle;
   });
-  INFO("tilt error " << tilt_error << ", spin error " << spin_error << ", precession "
-                     << azimuth << " vs " << p << ", steps " << summary.statistics.steps);
+  INFO("tilt error " << tilt_error << ", spin error " << spin_error << ", precession " << azimuth
+                     << " vs " << p << ", steps " << summary.statistics.steps);
   // Measured: tilt 1.6e-9 rad, spin 5.9e-11 rad/s, in 4202 steps.
   CHECK(tilt_error < 2e-8);
   CHECK(azimuth == Approx(p).epsilon(1e-7));

@@ -334,8 +334,7 @@ Model two_hinged_door(double gap = 0.0) {
   return model;
 }
 
-TEST_CASE("Over-constrained mechanism: the redundant joints are named, and it runs",
-          "[errors]") {
+TEST_CASE("Over-constrained mechanism: the redundant joints are named, and it runs", "[errors]") {
   Model model = two_hinged_door();
   Workspace ws(model);
   // The check for a model that must be free of redundancy still names them.
@@ -371,10 +370,10 @@ TEST_CASE("Over-constrained mechanism whose constraints contradict each other", 
   // names the hinges instead of running with a least-squares compromise.
   Model model = two_hinged_door(0.25);
   Workspace ws(model);
-  REQUIRE_THROWS_MATCHES(odyn::simulate(model, ws, short_run(), [](const Workspace&) {}),
-                         odyn::AssemblyError,
-                         AssemblyErrorAbout("hinge", {"could not be satisfied", "largest residual",
-                                                      "upper hinge", "lower hinge"}));
+  REQUIRE_THROWS_MATCHES(
+      odyn::simulate(model, ws, short_run(), [](const Workspace&) {}), odyn::AssemblyError,
+      AssemblyErrorAbout(
+          "hinge", {"could not be satisfied", "largest residual", "upper hinge", "lower hinge"}));
 }
 
 TEST_CASE("Assembly that cannot converge", "[errors]") {

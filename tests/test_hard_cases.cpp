@@ -49,14 +49,14 @@ struct Largest {
 namespace {
 
 struct BricardRun {
-  std::size_t reported = 0;       // redundant equations reported by the run
+  std::size_t reported = 0;                       // redundant equations reported by the run
   int min_deficiency = 100, max_deficiency = -1;  // rank deficiency of Phi_q by SVD, per output
-  double phi = 0.0;               // max |Phi|
-  double energy_error = 0.0;      // max |E - E0| / (m g L)
-  double force_mismatch = 0.0;    // max |Phi_q^T lambda - (Q - M v')| / |Q - M v'|
-  double null_at_start = 0.0;     // |N^T lambda| / |lambda| at t = 0
-  double null_later = 0.0;        // the same, largest over the run
-  double drop = 0.0;              // lowest z of bar 1's centre of mass
+  double phi = 0.0;                               // max |Phi|
+  double energy_error = 0.0;                      // max |E - E0| / (m g L)
+  double force_mismatch = 0.0;                    // max |Phi_q^T lambda - (Q - M v')| / |Q - M v'|
+  double null_at_start = 0.0;                     // |N^T lambda| / |lambda| at t = 0
+  double null_later = 0.0;                        // the same, largest over the run
+  double drop = 0.0;                              // lowest z of bar 1's centre of mass
   long steps = 0;
 };
 
@@ -128,10 +128,9 @@ TEST_CASE("Bricard's linkage: redundant constraints, reported, and it moves", "[
                                        << fine.min_deficiency << ".." << fine.max_deficiency);
   INFO("max |Phi| " << fine.phi << "; energy error / (m g L): " << coarse.energy_error
                     << " at h = 2e-3, " << fine.energy_error << " at h = 1e-3");
-  INFO("Phi_q^T lambda against Q - M v': " << fine.force_mismatch
-                                           << "; null-space part of lambda at t = 0: "
-                                           << fine.null_at_start << ", later up to "
-                                           << fine.null_later);
+  INFO("Phi_q^T lambda against Q - M v': "
+       << fine.force_mismatch << "; null-space part of lambda at t = 0: " << fine.null_at_start
+       << ", later up to " << fine.null_later);
   CHECK(fine.reported == 1);
   CHECK(fine.min_deficiency == 1);
   CHECK(fine.max_deficiency == 1);
@@ -215,9 +214,8 @@ TEST_CASE("A rocker driven through a full turn locks at its dead point: a clear 
   const Eigen::Vector2d b0 = parallelogram::point_b(p, 0.0);
   const double phi0 = std::atan2(b0.y(), b0.x() - p.ground);
   const double reach = p.coupler - p.crank;
-  const double phi_dead =
-      std::acos((reach * reach - p.ground * p.ground - p.rocker * p.rocker) /
-                (2.0 * p.ground * p.rocker));
+  const double phi_dead = std::acos((reach * reach - p.ground * p.ground - p.rocker * p.rocker) /
+                                    (2.0 * p.ground * p.rocker));
   const double t_dead = (phi_dead - phi0) / p.speed;
   REQUIRE(t_dead > 0.1);
   odyn::Workspace<parallelogram::Model> ws(l.model);
@@ -236,11 +234,10 @@ TEST_CASE("A rocker driven through a full turn locks at its dead point: a clear 
     CHECK(e.time() <= t_dead + 2.0 * settings.step);
     CHECK_THAT(message, Catch::Contains("t = ") && Catch::Contains("locked or singular"));
     // It names the joint with the largest residual, one of the loop's.
-    const bool names_a_joint = message.find("'O2'") != std::string::npos ||
-                               message.find("'A'") != std::string::npos ||
-                               message.find("'B'") != std::string::npos ||
-                               message.find("'O4'") != std::string::npos ||
-                               message.find("'motor O4'") != std::string::npos;
+    const bool names_a_joint =
+        message.find("'O2'") != std::string::npos || message.find("'A'") != std::string::npos ||
+        message.find("'B'") != std::string::npos || message.find("'O4'") != std::string::npos ||
+        message.find("'motor O4'") != std::string::npos;
     CHECK(names_a_joint);
   }
   // The run stopped at the last good state: finite, before the dead point.
@@ -259,8 +256,7 @@ namespace {
 /// The heavy top about its fixed point, integrated by classical RK4 in the body angular
 /// velocity and the orientation quaternion (normalized after each step):
 ///   J_O w' = -w x J_O w + c x (R^T m g),   q' = q (0, w) / 2.
-Eigen::Quaterniond heavy_top_reference(const heavy_top::Parameters& p, double t_end,
-                                       double step) {
+Eigen::Quaterniond heavy_top_reference(const heavy_top::Parameters& p, double t_end, double step) {
   using Eigen::Matrix3d;
   using Eigen::Quaterniond;
   using Eigen::Vector3d;
@@ -328,8 +324,8 @@ TopRun run_heavy_top(double step, double t_end, const Eigen::Quaterniond& refere
     if (w.t == 0.0) energy0 = energy, lz0 = l.z(), l0 = l.norm();
     run.energy = std::max(run.energy, std::abs(energy - energy0) / std::abs(energy0));
     run.momentum = std::max(run.momentum, std::abs(l.z() - lz0) / l0);
-    run.spin = std::max(run.spin,
-                        std::abs(omega.y() - p.angular_velocity.y()) / p.angular_velocity.y());
+    run.spin =
+        std::max(run.spin, std::abs(omega.y() - p.angular_velocity.y()) / p.angular_velocity.y());
     run.phi = std::max(run.phi, w.phi.cwiseAbs().maxCoeff());
   });
   const Eigen::Quaterniond q(ws.q[3], ws.q[4], ws.q[5], ws.q[6]);
@@ -404,8 +400,8 @@ TEST_CASE("Stiff chain: stable far beyond the explicit limit, fast mode damped b
   const Eigen::Vector2d u0(p.displacement1, p.displacement2);
   const double slow0 = slow.dot(p.mass * u0);  // modal coordinates (mass-normalized modes)
   const double h = 1e-2;
-  INFO("omega " << omega_slow << " and " << omega_fast << " rad/s; h omega_max = "
-                << h * omega_fast << ", h / (2 / omega_max) = " << h * omega_fast / 2.0);
+  INFO("omega " << omega_slow << " and " << omega_fast << " rad/s; h omega_max = " << h * omega_fast
+                << ", h / (2 / omega_max) = " << h * omega_fast / 2.0);
   REQUIRE(h * omega_fast > 100.0);
 
   for (const double rho : {0.9, 0.6}) {
@@ -431,10 +427,9 @@ TEST_CASE("Stiff chain: stable far beyond the explicit limit, fast mode damped b
     const std::size_t from = rho > 0.8 ? 30 : 10, to = rho > 0.8 ? 60 : 30;
     const double decay =
         std::pow(amplitude[to] / amplitude[from], 1.0 / static_cast<double>(to - from));
-    INFO("rho_inf " << rho << ": fast-mode decay per step " << decay << " (steps " << from
-                    << " to " << to << "), amplitude " << amplitude.front() << " -> "
-                    << amplitude.back() << ", slow-mode error " << slow_error.value << " of "
-                    << slow0);
+    INFO("rho_inf " << rho << ": fast-mode decay per step " << decay << " (steps " << from << " to "
+                    << to << "), amplitude " << amplitude.front() << " -> " << amplitude.back()
+                    << ", slow-mode error " << slow_error.value << " of " << slow0);
     CHECK(std::abs(decay - rho) < 0.025);
     CHECK(amplitude.back() < 1e-6 * amplitude.front());  // stable and damped out
     CHECK(fast_displacement.value < 2.0 * std::abs(fast.dot(p.mass * u0)));
@@ -485,11 +480,10 @@ TEST_CASE("Double pendulum over 1000 s: energy and constraints do not drift", "[
   first_mean /= first_count;
   last_mean /= last_count;
   INFO("1000 s at h = " << settings.step << " (" << summary.statistics.steps << " steps, "
-                        << summary.wall_seconds << " s): max |E - E0| / (m g l) = "
-                        << energy.value << ", mean over the first 100 s " << first_mean
-                        << ", over the last 100 s " << last_mean << "; max |Phi| " << phi.value
-                        << ", max |Phi_q v| " << velocity.value << ", pin gap " << gap.value
-                        << " m");
+                        << summary.wall_seconds << " s): max |E - E0| / (m g l) = " << energy.value
+                        << ", mean over the first 100 s " << first_mean << ", over the last 100 s "
+                        << last_mean << "; max |Phi| " << phi.value << ", max |Phi_q v| "
+                        << velocity.value << ", pin gap " << gap.value << " m");
   // Bounded, not drifting: generalized-alpha's O(h^2) energy error oscillates with the motion;
   // its numerical damping (rho_inf 0.9) acts on the high frequencies only.
   CHECK(energy.value < 5e-3);

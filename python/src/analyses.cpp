@@ -4,7 +4,9 @@
 
 namespace odyn::python {
 
-void bind_spatial_analyses(py::module_& m) { analysis::bind<SpatialBox>(m); }
+void bind_spatial_analyses(py::module_& m) {
+  analysis::bind<SpatialBox>(m);
+}
 
 void bind_integrators(py::module_& m) {
   m.def(

@@ -74,7 +74,7 @@ void write_state(const State& state, std::vector<double>& out) {
 }
 
 inline py::array_t<double> to_array(const std::vector<double>& data, py::ssize_t rows,
-                             std::vector<py::ssize_t> shape_of_row = {}) {
+                                    std::vector<py::ssize_t> shape_of_row = {}) {
   std::vector<py::ssize_t> shape{rows};
   shape.insert(shape.end(), shape_of_row.begin(), shape_of_row.end());
   py::array_t<double> array(shape);

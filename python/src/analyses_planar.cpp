@@ -5,6 +5,8 @@
 
 namespace odyn::python {
 
-void bind_planar_analyses(py::module_& m) { analysis::bind<PlanarBox>(m); }
+void bind_planar_analyses(py::module_& m) {
+  analysis::bind<PlanarBox>(m);
+}
 
 }  // namespace odyn::python

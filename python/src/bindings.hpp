@@ -182,11 +182,11 @@ using PlanarEngineGasForce = engine::planar::GasForce;
 
 /// The spatial model type of the bindings. Its element list and its element_type_names go
 /// together.
-using Model = sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal,
-                        sp::Cylindrical, sp::Fixed, sp::Distance, sp::RevoluteDriver,
-                        sp::TranslationalDriver, sp::Gravity, sp::PointForce, sp::PointTorque,
-                        sp::Tsda, sp::Rsda, EngineGasForce, UserForceT<Spatial, 1>,
-                        UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+using Model =
+    sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
+              sp::Fixed, sp::Distance, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
+              sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce,
+              UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
 using PlanarModel =
@@ -213,20 +213,42 @@ template <class M>
 struct ElementTypeNames;
 template <>
 struct ElementTypeNames<Model> {
-  static constexpr std::array<const char*, Model::num_types> value = {
-      "revolute",         "translational",   "spherical",       "universal",
-      "cylindrical",      "fixed",           "distance",        "revolute_driver",
-      "translational_driver",                "gravity",         "point_force",
-      "point_torque",     "tsda",            "rsda",            "engine_gas_force",
-      "user_force",       "user_force",      "signal_watch"};
+  static constexpr std::array<const char*, Model::num_types> value = {"revolute",
+                                                                      "translational",
+                                                                      "spherical",
+                                                                      "universal",
+                                                                      "cylindrical",
+                                                                      "fixed",
+                                                                      "distance",
+                                                                      "revolute_driver",
+                                                                      "translational_driver",
+                                                                      "gravity",
+                                                                      "point_force",
+                                                                      "point_torque",
+                                                                      "tsda",
+                                                                      "rsda",
+                                                                      "engine_gas_force",
+                                                                      "user_force",
+                                                                      "user_force",
+                                                                      "signal_watch"};
 };
 template <>
 struct ElementTypeNames<PlanarModel> {
-  static constexpr std::array<const char*, PlanarModel::num_types> value = {
-      "revolute",         "translational",   "fixed",           "distance",
-      "revolute_driver",  "translational_driver",               "gravity",
-      "point_force",      "point_torque",    "tsda",            "rsda",
-      "engine_gas_force", "user_force",      "user_force",      "signal_watch"};
+  static constexpr std::array<const char*, PlanarModel::num_types> value = {"revolute",
+                                                                            "translational",
+                                                                            "fixed",
+                                                                            "distance",
+                                                                            "revolute_driver",
+                                                                            "translational_driver",
+                                                                            "gravity",
+                                                                            "point_force",
+                                                                            "point_torque",
+                                                                            "tsda",
+                                                                            "rsda",
+                                                                            "engine_gas_force",
+                                                                            "user_force",
+                                                                            "user_force",
+                                                                            "signal_watch"};
 };
 static_assert(ElementTypeNames<Model>::value.back() != nullptr &&
                   ElementTypeNames<PlanarModel>::value.back() != nullptr,
@@ -258,7 +280,7 @@ bool is_callable(const py::dict& d, const char* key);
 Axes axes(const py::dict& d);
 Motion motion(const py::dict& d, const std::string& what);
 std::function<double(double, double, double)> scalar_function3(py::object f,
-                                                                const std::string& what);
+                                                               const std::string& what);
 
 /// Registers the analyses (assembly, dynamics) of each model on the module
 /// (analyses_spatial.cpp, analyses_planar.cpp), and what is common to both (analyses.cpp).

@@ -91,8 +91,7 @@ FrameView<Planar>::FrameView() {
   object_ = py::module_::import("types").attr("SimpleNamespace")(
       py::arg("position") = view({2}, position), py::arg("angle") = 0.0,
       py::arg("rotation") = view({2, 2}, rotation),
-      py::arg("linear_velocity") = view({2}, linear_velocity),
-      py::arg("angular_velocity") = 0.0);
+      py::arg("linear_velocity") = view({2}, linear_velocity), py::arg("angular_velocity") = 0.0);
 }
 
 void FrameView<Planar>::load(const Planar::Frame& frame) {
@@ -125,8 +124,7 @@ Callable<Space>::~Callable() {
 }
 
 template <class Space>
-py::object Callable<Space>::call_with_frames(double t,
-                                             const typename Space::Frame* const* frames) {
+py::object Callable<Space>::call_with_frames(double t, const typename Space::Frame* const* frames) {
   // Vectorcall with the argument slots on the stack: no tuple is built.
   std::array<PyObject*, 4> args{};  // slot 0 is scratch (PY_VECTORCALL_ARGUMENTS_OFFSET)
   py::object time = py::reinterpret_steal<py::object>(PyFloat_FromDouble(t));
@@ -192,7 +190,7 @@ std::function<double(Args...)> scalar_function(py::object f, const std::string& 
 }  // namespace
 
 std::function<double(double, double, double)> scalar_function3(py::object f,
-                                                                const std::string& what) {
+                                                               const std::string& what) {
   return scalar_function<double, double, double>(std::move(f), what);
 }
 
@@ -321,8 +319,8 @@ void add_element(SpatialBox& box, const std::string& type, const py::dict& d) {
     if (names.size() == 1)
       return void(model.add(UserForceT<Spatial, 1>(name, {model.body(names[0])}, callable)));
     if (names.size() == 2)
-      return void(
-          model.add(UserForceT<Spatial, 2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
+      return void(model.add(
+          UserForceT<Spatial, 2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
     throw ModelError(name, "a user force acts on one or two bodies");
   }
   throw ModelError(name, "unknown element type '" + type + "'");
@@ -353,8 +351,7 @@ void bind_model(py::module_& m, const char* name, const char* doc, AddBody add_b
       .def("add_element", add_element_function, py::arg("type"), py::arg("parameters"))
       .def_property_readonly("space", [](const Box&) { return std::string(Box::space_name); })
       .def_property_readonly("num_bodies", [](const Box& b) { return b.model.num_bodies(); })
-      .def_property_readonly("num_equations",
-                             [](const Box& b) { return b.model.num_equations(); })
+      .def_property_readonly("num_equations", [](const Box& b) { return b.model.num_equations(); })
       .def("body_index",
            [](const Box& b, const std::string& body) { return b.model.body(body).index; })
       .def("element_type", [](const Box& b, const std::string& element) {

@@ -112,14 +112,16 @@ void add_planar_element(PlanarBox& box, const std::string& type, const py::dict&
   if (type == "tsda") {
     pl::Tsda::Parameters p{
         number(d, "stiffness"), number(d, "damping"), number(d, "free_length"), {}};
-    if (is_callable(d, "actuator")) p.actuator = scalar_function3(d["actuator"], what + " actuator");
+    if (is_callable(d, "actuator"))
+      p.actuator = scalar_function3(d["actuator"], what + " actuator");
     return void(model.add(
         pl::Tsda(name, body("body_a"), vec2(d, "point_a"), body("body_b"), vec2(d, "point_b"), p)));
   }
   if (type == "rsda") {
     pl::Rsda::Parameters p{
         number(d, "stiffness"), number(d, "damping"), number(d, "free_angle"), {}};
-    if (is_callable(d, "actuator")) p.actuator = scalar_function3(d["actuator"], what + " actuator");
+    if (is_callable(d, "actuator"))
+      p.actuator = scalar_function3(d["actuator"], what + " actuator");
     return void(model.add(pl::Rsda(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
                                    joint_frame(d, "on_b"), p)));
   }

@@ -42,8 +42,7 @@ struct RedundantEquation {
   int row = 0;        // row of Phi
   /// "joint (equation k, row r)".
   std::string text() const {
-    return joint + " (equation " + std::to_string(equation) + ", row " + std::to_string(row) +
-           ")";
+    return joint + " (equation " + std::to_string(equation) + ", row " + std::to_string(row) + ")";
   }
 };
 

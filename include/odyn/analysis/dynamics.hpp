@@ -249,9 +249,11 @@ inline BdfSettings integrator_settings(const DynamicsSettings& s) {
 }
 
 inline StepControl step_control(const DynamicsSettings& s) {
-  return StepControl{.rtol = s.rtol, .atol = s.atol, .first_step = s.step,
-                     .max_step = s.max_step > 0.0 ? s.max_step
-                                                  : std::numeric_limits<double>::infinity()};
+  return StepControl{
+      .rtol = s.rtol,
+      .atol = s.atol,
+      .first_step = s.step,
+      .max_step = s.max_step > 0.0 ? s.max_step : std::numeric_limits<double>::infinity()};
 }
 }  // namespace detail
 
@@ -288,8 +290,7 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   RunSummary summary;
   summary.assembly = assemble(model, ws, s.assembly);
   summary.redundant_equations = redundant_equations(model, ws);
-  Integrator integrator(model, ws,
-                        detail::integrator_settings<typename Integrator::Settings>(s),
+  Integrator integrator(model, ws, detail::integrator_settings<typename Integrator::Settings>(s),
                         detail::step_control(s));
 
   auto record = [&] {

@@ -86,8 +86,8 @@ class Bdf {
     if (!(proposed_step_ > 0.0))
       throw ModelError("bdf", "the first step must be positive, got " + to_text(proposed_step_));
     if (settings.max_order < 1 || settings.max_order > kMaxOrder)
-      throw ModelError("bdf", "max_order must lie in [1, 5], got " +
-                                  std::to_string(settings.max_order));
+      throw ModelError("bdf",
+                       "max_order must lie in [1, 5], got " + std::to_string(settings.max_order));
     if (!(settings.newton_tolerance > 0.0) || !(settings.constraint_tolerance > 0.0) ||
         settings.max_iterations < 1 || !(settings.reuse_band >= 1.0) ||
         !(settings.max_growth > 1.0))
@@ -143,8 +143,8 @@ class Bdf {
     error_ = std::numeric_limits<double>::infinity();
     coefficients(h);
     for (int tries = 0; tries < 2; ++tries) {
-      const bool fresh = !factorized_ || std::abs(std::log(c_ / c_factorized_)) >
-                                             std::log(settings_.reuse_band);
+      const bool fresh =
+          !factorized_ || std::abs(std::log(c_ / c_factorized_)) > std::log(settings_.reuse_band);
       if (fresh) factorized_ = false;
       if (solve_step(t_n_ + h)) {
         newton_failed_ = false;
@@ -413,8 +413,8 @@ class Bdf {
   void rates(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& vdot,
              Eigen::VectorXd& out) const {
     for (int b = 0; b < model_.num_bodies(); ++b)
-      out.template segment<nq>(b * nq) = Space::configuration_rate(
-          q.template segment<nq>(b * nq), v.template segment<nv>(b * nv));
+      out.template segment<nq>(b * nq) =
+          Space::configuration_rate(q.template segment<nq>(b * nq), v.template segment<nv>(b * nv));
     out.tail(nv_total_) = vdot;
   }
 
@@ -578,8 +578,7 @@ class Bdf {
         rate_factor_ = rate / (1.0 - rate);
       }
       const bool small = negligible || rate_factor_ * norm <= settings_.newton_tolerance;
-      if (small &&
-          (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
+      if (small && (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
         if (k + 1 > settings_.reuse_iterations) factorized_ = false;
         return true;
       }
@@ -646,9 +645,8 @@ class Bdf {
     });
     Eigen::Index row = 0;
     const double worst = m_ > 0 ? ws_.phi.cwiseAbs().maxCoeff(&row) : 0.0;
-    return "bdf: Newton iteration did not converge in " +
-           std::to_string(settings_.max_iterations) + " iterations at order " +
-           std::to_string(order_) + ", step " + to_text(h_) +
+    return "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
+           " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) +
            " s (largest constraint residual " + to_text(worst) + " at '" +
            (m_ > 0 ? model_.constraint_name(static_cast<int>(row)) : std::string("-")) + "'" +
            (strongest.empty() ? std::string()
@@ -661,8 +659,8 @@ class Bdf {
   Workspace<Model>& ws_;
   Settings settings_;
   StepControl control_;
-  Solver solver_;     // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
-  Solver projector_;  // [M, Phi_q^T; Phi_q, 0]
+  Solver solver_;         // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
+  Solver projector_;      // [M, Phi_q^T; Phi_q, 0]
   Solver output_solver_;  // the same matrix at interpolated output points
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, ny_ = 0;

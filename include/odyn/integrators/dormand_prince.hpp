@@ -274,18 +274,17 @@ class DormandPrince {
 
   /// y_dense_ = the continuous extension of the last attempt at t.
   void dense_state(double t) {
-    static constexpr double d1 = -12715105075.0 / 11282082432.0,
-                            d3 = 87487479700.0 / 32700410799.0,
+    static constexpr double d1 = -12715105075.0 / 11282082432.0, d3 = 87487479700.0 / 32700410799.0,
                             d4 = -10690763975.0 / 1880347072.0,
-                            d5 = 701980252875.0 / 199316789632.0,
-                            d6 = -1453857185.0 / 822651844.0, d7 = 69997945.0 / 29380423.0;
+                            d5 = 701980252875.0 / 199316789632.0, d6 = -1453857185.0 / 822651844.0,
+                            d7 = 69997945.0 / 29380423.0;
     const double theta = (t - t_n_) / h_, rest = 1.0 - theta;
     // y(theta) = y_n + theta (dy + rest (b + theta (c + rest d))) with dy = y_{n+1} - y_n,
     // b = h k_1 - dy, c = dy - h k_7 - b and d = h (d1 k_1 + d3 k_3 + ... + d7 k_7).
     stage_ = h_ * (d1 * k_[0] + d3 * k_[2] + d4 * k_[3] + d5 * k_[4] + d6 * k_[5] + d7 * k_new_);
-    y_dense_ = y_trial_ - y_n_;                                   // dy
+    y_dense_ = y_trial_ - y_n_;                                                   // dy
     stage_ = (y_dense_ - h_ * k_new_ - (h_ * k_[0] - y_dense_)) + rest * stage_;  // c + rest d
-    stage_ = (h_ * k_[0] - y_dense_) + theta * stage_;            // b + theta (...)
+    stage_ = (h_ * k_[0] - y_dense_) + theta * stage_;                            // b + theta (...)
     y_dense_ = y_n_ + theta * (y_dense_ + rest * stage_);
   }
 

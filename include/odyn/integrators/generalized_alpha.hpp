@@ -59,8 +59,8 @@ class GeneralizedAlpha {
         settings_(settings),
         control_(control),
         proposed_step_(std::min(control.first_step, control.max_step)) {
-    if (settings.adaptive && (!(control.rtol > 0.0) || !(control.atol > 0.0) ||
-                              !(proposed_step_ > 0.0)))
+    if (settings.adaptive &&
+        (!(control.rtol > 0.0) || !(control.atol > 0.0) || !(proposed_step_ > 0.0)))
       throw ModelError(settings.hht ? "hht" : "generalized-alpha",
                        "rtol, atol and the first step must be positive, got " +
                            to_text(control.rtol) + ", " + to_text(control.atol) + " and " +
@@ -179,8 +179,8 @@ class GeneralizedAlpha {
     if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     a_previous_ = a_step_;
-    a_n_ = ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) /
-           (1.0 - alpha_m_);
+    a_n_ =
+        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / (1.0 - alpha_m_);
     vdot_previous_ = vdot_n_;
     lambda_previous_ = lambda_n_;
     previous_step_ = h_;
@@ -311,8 +311,8 @@ class GeneralizedAlpha {
     for (int b = 0; b < model_.num_bodies(); ++b)
       error_scale_.template segment<nv>(b * nv) =
           Model::Space::coordinate_scale(ws_.q.template segment<nq>(b * nq));
-    error_ = weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol,
-                               control_.atol);
+    error_ =
+        weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol, control_.atol);
   }
 
   /// d(q_{n+1})/d(v'_{n+1}) and d(v_{n+1})/d(v'_{n+1}).
@@ -434,8 +434,8 @@ class GeneralizedAlpha {
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start
   Eigen::VectorXd inverse_mass_diagonal_;                // (nv_total)
   Eigen::VectorXd jerk_;                                 // (nv_total) v'' at the last restart
-  bool starting_ = false;      // the next step is the first after a restart
-  Eigen::VectorXd increment_;  // (nv_total) configuration increment
+  bool starting_ = false;       // the next step is the first after a restart
+  Eigen::VectorXd increment_;   // (nv_total) configuration increment
   Eigen::VectorXd a_step_;      // (nv_total) a_n shifted to the size of the attempted step
   Eigen::VectorXd a_previous_;  // (nv_total) a_{n-1}
   Eigen::VectorXd local_error_, error_scale_;  // (nv_total)

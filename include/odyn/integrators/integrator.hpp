@@ -42,11 +42,11 @@ struct IntegratorStatistics {
 
 /// Step-size control shared by the integrators that have it.
 struct StepControl {
-  double rtol = 1e-6;          // relative tolerance of the local error per component of (q, v)
-  double atol = 1e-6;          // absolute tolerance, in the units of each component
-  double first_step = 1e-4;    // s; the controller adapts from there
+  double rtol = 1e-6;        // relative tolerance of the local error per component of (q, v)
+  double atol = 1e-6;        // absolute tolerance, in the units of each component
+  double first_step = 1e-4;  // s; the controller adapts from there
   double max_step = std::numeric_limits<double>::infinity();  // s
-  double min_step = 1e-14;     // s; below this a step is hopeless and the run stops
+  double min_step = 1e-14;  // s; below this a step is hopeless and the run stops
 };
 
 /// The weighted root-mean-square norm of a local error estimate:
@@ -66,8 +66,8 @@ inline double weighted_rms_norm(const Eigen::Ref<const Eigen::VectorXd>& error,
 
 /// The step-size factor of an elementary controller for a method whose local error is of order
 /// `order + 1` in h: safety * error^(-1/(order + 1)), kept within [min_factor, max_factor].
-inline double step_factor(double error, int order, double min_factor = 0.2,
-                          double max_factor = 5.0, double safety = 0.9) {
+inline double step_factor(double error, int order, double min_factor = 0.2, double max_factor = 5.0,
+                          double safety = 0.9) {
   if (!std::isfinite(error)) return min_factor;
   if (error <= 0.0) return max_factor;
   return std::clamp(safety * std::pow(error, -1.0 / (order + 1)), min_factor, max_factor);

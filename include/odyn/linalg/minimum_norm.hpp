@@ -23,8 +23,8 @@ void make_multipliers_minimum_norm(const Model& model, Workspace<Model>& ws) {
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(m, n);
   write_jacobian(model, ws, jacobian, 0, 0, false);
   const Eigen::VectorXd forces = jacobian.transpose() * ws.lambda;
-  ws.lambda = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(jacobian.transpose())
-                  .solve(forces);
+  ws.lambda =
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(jacobian.transpose()).solve(forces);
 }
 
 }  // namespace odyn
