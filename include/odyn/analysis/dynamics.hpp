@@ -1,6 +1,7 @@
 #pragma once
-// Dynamic analysis: assemble, then integrate with fixed steps that land on every output time,
-// and hand the workspace to an observer at t0 and at each output time.
+// Dynamic analysis: assemble, then integrate with the chosen integrator (fixed steps, or steps
+// under error control with outputs interpolated where the integrator can), end steps exactly on
+// the switches of force laws, and hand the workspace to an observer at t0 and at each output.
 
 #include <Eigen/Core>
 #include <chrono>

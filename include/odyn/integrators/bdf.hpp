@@ -40,6 +40,7 @@
 #include <limits>
 #include <string>
 
+#include "odyn/analysis/diagnosis.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
@@ -617,41 +618,13 @@ class Bdf {
   }
 
   std::string failure_message() const {
-    if (!rhs_.allFinite() || !ws_.force.allFinite()) {
-      std::string culprit = "an element";
-      model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-        if constexpr (ForceElement<E>) {
-          const auto& blocks = std::get<type>(ws_.blocks);
-          for (std::size_t i = 0; i < pool.size(); ++i)
-            for (const auto& f : blocks[i].force)
-              if (!f.allFinite()) culprit = "force element '" + pool[i].name() + "'";
-        }
-      });
-      return "bdf: Newton iteration produced a non-finite value; " + culprit +
+    if (!rhs_.allFinite() || !ws_.force.allFinite())
+      return "bdf: Newton iteration produced a non-finite value; " +
+             diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
-    }
-    std::string strongest;
-    double strongest_force = 0.0;
-    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-      if constexpr (ForceElement<E>) {
-        const auto& blocks = std::get<type>(ws_.blocks);
-        for (std::size_t i = 0; i < pool.size(); ++i)
-          for (const auto& f : blocks[i].force)
-            if (f.norm() > strongest_force) {
-              strongest_force = f.norm();
-              strongest = pool[i].name();
-            }
-      }
-    });
-    Eigen::Index row = 0;
-    const double worst = m_ > 0 ? ws_.phi.cwiseAbs().maxCoeff(&row) : 0.0;
     return "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
-           " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) +
-           " s (largest constraint residual " + to_text(worst) + " at '" +
-           (m_ > 0 ? model_.constraint_name(static_cast<int>(row)) : std::string("-")) + "'" +
-           (strongest.empty() ? std::string()
-                              : ", largest applied force from '" + strongest + "' (" +
-                                    to_text(strongest_force) + ")") +
+           " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) + " s (" +
+           diagnosis::worst_constraint(model_, ws_) + diagnosis::strongest_force(model_, ws_) +
            "). Check the force elements' parameters, or look for a locked or singular mechanism.";
   }
 
