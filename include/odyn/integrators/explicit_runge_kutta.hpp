@@ -1,0 +1,451 @@
+#pragma once
+// Explicit Runge-Kutta methods with step-size control, on the index-1 form of the equations of
+// motion, with the state projected back onto the constraints after every step and a continuous
+// extension for dense output. The method (stages, coefficients, error estimate, dense output)
+// is a compile-time parameter: dormand_prince.hpp (5(4), "dopri5") and dop853.hpp (8(5,3),
+// "dop853") are each a tableau and an alias of the class below.
+//
+// The state y = (q, v) follows q' = rate(q, v) (the quaternion as 4 numbers, renormalized) and
+// v' from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at every stage. Index 1 lets the
+// positions and velocities drift off Phi = 0 and Phi_q v + Phi_t = 0 by the local error; after
+// each step both are projected back in the mass metric (the nearest consistent state), which
+// keeps the order and stops the drift. One solve of the saddle-point system per stage, no
+// Newton iteration on the dynamics: cheap per step when the problem is not stiff.
+//
+// Step control as in Hairer, Norsett & Wanner, "Solving Ordinary Differential Equations I",
+// Sect. II.4; continuous extensions as in Sect. II.6.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <concepts>
+#include <cstddef>
+#include <limits>
+#include <string>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/core/errors.hpp"
+#include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/saddle_point.hpp"
+
+namespace odyn {
+
+/// Settings of the explicit Runge-Kutta integrators (dopri5, dop853): the projection.
+struct DormandPrinceSettings {
+  /// Positions are projected until every entry of Phi is below this.
+  double projection_tolerance = 1e-12;
+  int max_projection_iterations = 6;
+};
+
+/// What a method type gives the integrator below, with s = stages (k_0 = f at the committed
+/// state; k_s = f at the projected end of the step; k_{s+1}.. the extra stages of the dense
+/// output):
+///   name, order;
+///   c[s], a[s][s]: stage i at t_n + c_i h, y_n + h sum_{j<i} a_ij k_j;
+///   b[s]: y_{n+1} = y_n + h sum b_i k_i, unless last_stage_is_new_point (first same as last:
+///     the last stage sits at y_{n+1}, so the solver already holds the matrix there);
+///   error_weights[s]: h sum e_i k_i estimates the local error, of order error_order + 1 in h;
+///     with low_order_error_weights as well, the two estimates combine as in Hairer's dop853;
+///   min_step_factor, max_step_factor: bounds of the step-size change;
+///   extra_stages, extra_c, extra_a[e][s + 1 + e]: stages only the dense output needs;
+///   dense_rows, dense[r][s + 1 + extra_stages]: the continuous extension (see dense_state).
+template <class M>
+concept ExplicitRungeKuttaMethod = requires {
+  { M::name } -> std::convertible_to<const char*>;
+  { M::order } -> std::convertible_to<int>;
+  { M::error_order } -> std::convertible_to<int>;
+  { M::stages } -> std::convertible_to<int>;
+  { M::extra_stages } -> std::convertible_to<int>;
+  { M::dense_rows } -> std::convertible_to<int>;
+  { M::last_stage_is_new_point } -> std::convertible_to<bool>;
+  { M::min_step_factor } -> std::convertible_to<double>;
+  { M::max_step_factor } -> std::convertible_to<double>;
+  M::c[0] + M::a[0][0] + M::b[0] + M::error_weights[0] + M::dense[0][0];
+};
+
+template <ExplicitRungeKuttaMethod Method, class Model, class Solver = BlockSchurSaddlePoint<Model>>
+class ExplicitRungeKutta {
+ public:
+  using Settings = DormandPrinceSettings;
+  static constexpr int nv = Model::nv;
+  static constexpr int nq = Model::nq;
+  static constexpr int order = Method::order;
+
+  /// Starts from the workspace's consistent state (see assemble), with the first step and the
+  /// tolerances of `control`.
+  ExplicitRungeKutta(const Model& model, Workspace<Model>& ws, Settings settings = {},
+                     StepControl control = {})
+      : model_(model),
+        ws_(ws),
+        settings_(settings),
+        control_(control),
+        proposed_step_(std::min(control.first_step, control.max_step)) {
+    if (!(control.rtol > 0.0) || !(control.atol > 0.0))
+      throw ModelError(Method::name, "rtol and atol must be positive, got " +
+                                         to_text(control.rtol) + " and " + to_text(control.atol));
+    if (!(proposed_step_ > 0.0))
+      throw ModelError(Method::name,
+                       "the first step must be positive, got " + to_text(proposed_step_));
+    nq_total_ = model.num_coordinates();
+    nv_total_ = model.num_velocities();
+    m_ = model.num_equations();
+    size_ = nq_total_ + nv_total_;
+    y_n_ = Eigen::VectorXd::Zero(size_);
+    y_new_ = y_n_;
+    y_trial_ = y_n_;
+    y_dense_ = y_n_;
+    stage_ = y_n_;
+    for (auto& k : k_) k = y_n_;
+    for (auto& term : dense_terms_) term = y_n_;
+    vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
+    lambda_trial_ = Eigen::VectorXd::Zero(m_);
+    rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
+    velocity_residual_ = Eigen::VectorXd::Zero(m_);
+    solution_ = rhs_;
+    solver_.analyze(model);
+    initialize();
+  }
+
+  /// Takes the workspace's state as the committed one (v' and lambda solved afresh).
+  void initialize() {
+    t_n_ = ws_.t;
+    y_n_ << ws_.q, ws_.v;
+    restart();
+  }
+
+  /// After a switch of a force law (and at the start): the first stage again, at the
+  /// committed state with the new law.
+  void restart() {
+    rollback();
+    if (!derivative(t_n_, y_n_, k_[0]))
+      throw SolverError(t_n_,
+                        "the mass-constraint matrix is singular at the start of a step; "
+                        "check for redundant or locked constraints");
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    ++statistics_.restarts;
+  }
+
+  /// Tries a step of size h from the committed state. The workspace then holds the projected
+  /// trial state with its v' and lambda; error_norm() says whether the step is accurate
+  /// enough. False if a stage or the projection failed.
+  bool attempt(double h) {
+    h_ = h;
+    dense_ready_ = false;
+    for (int i = 1; i < s; ++i) {
+      combine(stage_, y_n_, h, Method::a[i], i);
+      if (!derivative(t_n_ + Method::c[i] * h, stage_, k_[i])) return false;
+    }
+    if constexpr (Method::last_stage_is_new_point)
+      y_new_ = stage_;
+    else
+      combine(y_new_, y_n_, h, Method::b, s);
+    error_ = estimate_error(h);
+    if (!std::isfinite(error_)) return false;
+    if (!project(t_n_ + h, y_new_, held_after_last_stage)) return false;
+    // The trial state, kept for restore_trial() and, with k at it, for the dense output.
+    y_trial_ << ws_.q, ws_.v;
+    vdot_trial_ = ws_.vdot;
+    lambda_trial_ = ws_.lambda;
+    derivative_at_workspace(k_[new_point]);
+    return true;
+  }
+
+  /// The state at t within the last attempted step (t_n <= t <= t_n + h), from the method's
+  /// continuous extension, projected onto the constraints, with v' and lambda there: the
+  /// workspace holds it as after an attempt.
+  bool interpolate(double t) {
+    if (!prepare_dense_output()) return false;
+    dense_state(t);
+    return project(t, y_dense_, HeldMatrix::none, true);
+  }
+
+  /// The interpolated positions and velocities at t and the frames from them, unprojected.
+  void interpolate_frames(double t) {
+    if (!prepare_dense_output()) fail();
+    dense_state(t);
+    ws_.t = t;
+    ws_.q = y_dense_.head(nq_total_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
+    ws_.v = y_dense_.tail(nv_total_);
+    update_frames(model_, ws_);
+  }
+
+  /// Puts the last attempt's trial state back into the workspace (after interpolate()).
+  void restore_trial() {
+    ws_.t = t_n_ + h_;
+    ws_.q = y_trial_.head(nq_total_);
+    ws_.v = y_trial_.tail(nv_total_);
+    ws_.vdot = vdot_trial_;
+    ws_.lambda = lambda_trial_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+  }
+
+  /// Local error of the last attempt in units of the tolerance (accept when <= 1).
+  double error_norm() const { return error_; }
+
+  /// Accepts the last attempt and proposes the next step from its error.
+  void accept() {
+    commit();
+    statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
+    const double grown = h_ * step_factor(error_, Method::error_order, Method::min_step_factor,
+                                          Method::max_step_factor);
+    // A step cut short to land on an output time says nothing against the longer step.
+    proposed_step_ =
+        std::min(control_.max_step, h_ < proposed_step_ ? std::max(proposed_step_, grown) : grown);
+  }
+
+  /// Rejects the last attempt and shrinks the step; throws once it is hopelessly short.
+  void reject() {
+    ++statistics_.rejected_steps;
+    proposed_step_ =
+        h_ * std::min(0.9, step_factor(error_, Method::error_order, Method::min_step_factor, 0.9));
+    rollback();
+    if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_)))
+      throw SolverError(t_n_, std::string(Method::name) + ": the step size fell below " +
+                                  to_text(control_.min_step) +
+                                  " s; the problem may be stiff (try bdf or generalized-alpha) "
+                                  "or the model singular");
+  }
+
+  /// Makes the trial state of the last attempt the committed one (no step-size change).
+  void commit() {
+    t_n_ += h_;
+    y_n_ = y_trial_;
+    k_[0] = k_[new_point];
+    vdot_n_ = ws_.vdot;
+    lambda_n_ = ws_.lambda;
+    dense_ready_ = false;
+    advance_states(model_, ws_);
+    ++statistics_.steps;
+  }
+
+  /// Puts the workspace back at the last committed state.
+  void rollback() {
+    ws_.t = t_n_;
+    ws_.q = y_n_.head(nq_total_);
+    ws_.v = y_n_.tail(nv_total_);
+    ws_.vdot = vdot_n_;
+    ws_.lambda = lambda_n_;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+  }
+
+  [[noreturn]] void fail() {
+    const double t_failed = t_n_ + h_;
+    rollback();
+    throw SolverError(t_failed, std::string(Method::name) +
+                                    ": a stage or the projection onto the constraints failed "
+                                    "(singular mass-constraint matrix or non-finite forces); "
+                                    "check for locked or redundant constraints and the force "
+                                    "elements' parameters");
+  }
+
+  bool adaptive() const { return true; }
+  double time() const { return t_n_; }
+  double proposed_step() const { return proposed_step_; }
+  void count_event() { ++statistics_.events; }
+  const IntegratorStatistics& statistics() const { return statistics_; }
+  const Settings& settings() const { return settings_; }
+
+ private:
+  static constexpr int s = Method::stages;
+  static constexpr int new_point = s;  // k_[s]: f at the projected end of the last attempt
+  static constexpr int num_derivatives = s + 1 + Method::extra_stages;
+  // y_{n+1} - y_n, h k_0 - (y_{n+1} - y_n), the Hermite term, then the method's dense rows.
+  static constexpr int num_dense_terms = 3 + Method::dense_rows;
+
+  /// What the solver holds when the projection starts: nothing useful, the matrix at the point
+  /// to project (first same as last), or at a point within the local error of it (a last stage
+  /// at t_n + h), good enough for chord iterations on the positions.
+  enum class HeldMatrix { none, at_point, near_point };
+  static constexpr HeldMatrix held_after_last_stage =
+      Method::last_stage_is_new_point ? HeldMatrix::at_point
+      : Method::c[s - 1] == 1.0       ? HeldMatrix::near_point
+                                      : HeldMatrix::none;
+
+  /// out = base + h sum_{j < count} weights_j k_j.
+  template <std::size_t N>
+  void combine(Eigen::VectorXd& out, const Eigen::VectorXd& base, double h,
+               const std::array<double, N>& weights, int count) {
+    out = base;
+    for (int j = 0; j < count; ++j)
+      if (weights[j] != 0.0) out.noalias() += (h * weights[j]) * k_[j];
+  }
+  template <std::size_t N>
+  void combine(Eigen::VectorXd& out, double h, const std::array<double, N>& weights, int count) {
+    out.setZero();
+    for (int j = 0; j < count; ++j)
+      if (weights[j] != 0.0) out.noalias() += (h * weights[j]) * k_[j];
+  }
+
+  /// The local error of the step to y_new_ in units of the tolerance. With a second, lower-order
+  /// estimate (dop853), err5^2 / sqrt(err5^2 + 0.01 err3^2): the fifth-order estimate, kept
+  /// from being too optimistic at large steps by the third-order one (Hairer's dop853).
+  double estimate_error(double h) {
+    combine(stage_, h, Method::error_weights, s);
+    double error = weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
+    if constexpr (requires { Method::low_order_error_weights; }) {
+      combine(stage_, h, Method::low_order_error_weights, s);
+      const double low = weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
+      const double denominator = std::sqrt(error * error + 0.01 * low * low);
+      error = denominator > 0.0 ? error * error / denominator : 0.0;
+    }
+    return error;
+  }
+
+  /// f(t, y): the configuration rate and v' (index 1) at a stage; leaves v' and lambda in the
+  /// workspace. False if the saddle-point matrix is singular or a value is not finite.
+  bool derivative(double t, const Eigen::VectorXd& y, Eigen::VectorXd& k) {
+    ++statistics_.residual_evaluations;
+    ws_.t = t;
+    ws_.q = y.head(nq_total_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
+    ws_.v = y.tail(nv_total_);
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    if (!accelerations()) return false;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
+          y.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
+    k.tail(nv_total_) = ws_.vdot;
+    return k.allFinite();
+  }
+
+  /// The derivative at the workspace's (consistent) state, whose v' is already solved.
+  void derivative_at_workspace(Eigen::VectorXd& k) {
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
+          ws_.q.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
+    k.tail(nv_total_) = ws_.vdot;
+  }
+
+  /// v' and lambda at the workspace's frames (constraints evaluated), factorizing afresh.
+  bool accelerations() {
+    evaluate_forces(model_, ws_);
+    evaluate_gamma(model_, ws_);
+    if (!factorize()) return false;
+    rhs_.head(nv_total_) = ws_.force;
+    rhs_.tail(m_) = ws_.gamma;
+    solver_.solve(rhs_, solution_);
+    ws_.vdot = solution_.head(nv_total_);
+    ws_.lambda = solution_.tail(m_);
+    return solution_.allFinite();
+  }
+
+  bool factorize() {
+    ++statistics_.factorizations;
+    return solver_.factorize(model_, ws_, IterationFactors{});
+  }
+
+  /// The extra stages and the terms of the continuous extension of the last attempt, computed
+  /// once per attempt and only when an output or an event asks for them.
+  bool prepare_dense_output() {
+    if (dense_ready_) return true;
+    if constexpr (Method::extra_stages > 0)
+      for (int e = 0; e < Method::extra_stages; ++e) {
+        combine(stage_, y_n_, h_, Method::extra_a[e], new_point + 1 + e);
+        if (!derivative(t_n_ + Method::extra_c[e] * h_, stage_, k_[new_point + 1 + e]))
+          return false;
+      }
+    auto& step = dense_terms_[0];
+    step = y_trial_ - y_n_;
+    dense_terms_[1] = h_ * k_[0] - step;
+    dense_terms_[2] = step - h_ * k_[new_point] - dense_terms_[1];
+    for (int r = 0; r < Method::dense_rows; ++r)
+      combine(dense_terms_[3 + r], h_, Method::dense[r], num_derivatives);
+    dense_ready_ = true;
+    return true;
+  }
+
+  /// y_dense_ = the continuous extension of the last attempt at t, in Hairer's nested form
+  /// y_n + theta (r_0 + (1 - theta) (r_1 + theta (r_2 + (1 - theta) (r_3 + ...)))), r = the
+  /// dense terms: a polynomial through both ends of the step with their derivatives.
+  void dense_state(double t) {
+    const double theta = (t - t_n_) / h_, rest = 1.0 - theta;
+    y_dense_ = dense_terms_[num_dense_terms - 1];
+    for (int r = num_dense_terms - 2; r >= 0; --r)
+      y_dense_ = dense_terms_[r] + (r % 2 == 0 ? rest : theta) * y_dense_;
+    y_dense_ = y_n_ + theta * y_dense_;
+  }
+
+  /// Moves y onto Phi = 0 and Phi_q v + Phi_t = 0, the least distance in the mass metric, and
+  /// solves v' and lambda there. The workspace then holds the projected state at t.
+  /// The positions take chord iterations with the matrix `held` (or factorized at y): the
+  /// corrections are of the size of the local error. v' and lambda start the next step, so
+  /// they are solved with the matrix at the projected positions, except at an `output_point`,
+  /// whose v' and lambda then carry a relative error of the size of the correction but feed
+  /// nothing back into the integration.
+  bool project(double t, const Eigen::VectorXd& y, HeldMatrix held, bool output_point = false) {
+    ws_.t = t;
+    ws_.q = y.head(nq_total_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
+    ws_.v = y.tail(nv_total_);
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    bool matrix_at_positions = held == HeldMatrix::at_point;
+    if (held == HeldMatrix::none) {
+      if (!factorize()) return false;
+      matrix_at_positions = true;
+    }
+    for (int k = 0; m_ > 0 && !(ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance);
+         ++k) {
+      if (k == settings_.max_projection_iterations) return false;
+      // [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]: the smallest correction in the mass metric.
+      rhs_.head(nv_total_).setZero();
+      rhs_.tail(m_) = -ws_.phi;
+      solver_.solve(rhs_, solution_);
+      ++statistics_.newton_iterations;
+      for (int b = 0; b < model_.num_bodies(); ++b)
+        Model::Space::integrate(Eigen::Matrix<double, nq, 1>(ws_.q.template segment<nq>(b * nq)),
+                                solution_.template segment<nv>(b * nv),
+                                ws_.q.template segment<nq>(b * nq));
+      update_frames(model_, ws_);
+      evaluate_constraints(model_, ws_);
+      matrix_at_positions = false;
+    }
+    if (!matrix_at_positions && !output_point && !factorize()) return false;
+    if (m_ > 0) {
+      // Velocities: [M Phi_q^T; Phi_q 0] [dv; mu] = [0; -(Phi_q v + Phi_t)].
+      jacobian_times(model_, ws_, ws_.v, velocity_residual_);
+      rhs_.head(nv_total_).setZero();
+      rhs_.tail(m_) = -(velocity_residual_ + ws_.phi_t);
+      solver_.solve(rhs_, solution_);
+      ws_.v += solution_.head(nv_total_);
+      update_frames(model_, ws_);
+    }
+    // v' and lambda at the projected state: the same matrix, new right-hand side.
+    evaluate_forces(model_, ws_);
+    evaluate_gamma(model_, ws_);
+    rhs_.head(nv_total_) = ws_.force;
+    rhs_.tail(m_) = ws_.gamma;
+    solver_.solve(rhs_, solution_);
+    ws_.vdot = solution_.head(nv_total_);
+    ws_.lambda = solution_.tail(m_);
+    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
+  }
+
+  const Model& model_;
+  Workspace<Model>& ws_;
+  Settings settings_;
+  StepControl control_;
+  Solver solver_;
+  IntegratorStatistics statistics_;
+  Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, size_ = 0;
+  double t_n_ = 0.0, h_ = 0.0, error_ = 0.0, proposed_step_ = 1e-4;
+  Eigen::VectorXd y_n_, y_new_, stage_, rhs_, solution_, velocity_residual_, vdot_n_, lambda_n_;
+  // Stage derivatives of the last attempt, f at its projected end, the extra dense stages.
+  std::array<Eigen::VectorXd, num_derivatives> k_;
+  // The last attempt's projected end state, its v' and lambda; a dense-output point.
+  Eigen::VectorXd y_trial_, vdot_trial_, lambda_trial_, y_dense_;
+  std::array<Eigen::VectorXd, num_dense_terms> dense_terms_;
+  bool dense_ready_ = false;  // dense_terms_ (and the extra stages) belong to the last attempt
+};
+
+}  // namespace odyn
