@@ -15,6 +15,7 @@
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/integrators/bdf.hpp"
+#include "odyn/integrators/dop853.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/generalized_alpha.hpp"
 #include "odyn/integrators/integrator.hpp"
@@ -28,14 +29,15 @@ struct DynamicsSettings {
   double t_end = 1.0;             // s
   double output_interval = 1e-3;  // s
   /// By name (see integrator_names()): "generalized-alpha" or "hht" (fixed step, or error
-  /// control when generalized_alpha.adaptive is set), "dopri5" (error control).
+  /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
+  /// control).
   std::string integrator = "generalized-alpha";
   /// Local error tolerances of the runs with error control, per component of (q, v).
   double rtol = 1e-6;
   double atol = 1e-6;
   double max_step = 0.0;  // s; 0: no limit
   GeneralizedAlphaSettings generalized_alpha = {};
-  DormandPrinceSettings dormand_prince = {};
+  DormandPrinceSettings dormand_prince = {};  // dopri5 and dop853
   BdfSettings bdf = {};
   AssemblySettings assembly = {};
 };
@@ -265,6 +267,7 @@ inline const std::vector<std::pair<std::string, std::string>>& integrator_names(
        "index-3 generalized-alpha (Chung-Hulbert), fixed step h or, with adaptive, rtol/atol"},
       {"hht", "index-3 HHT-alpha, fixed step h or, with adaptive, rtol/atol"},
       {"dopri5", "explicit Dormand-Prince 5(4), index 1 with projection, rtol/atol"},
+      {"dop853", "explicit Dormand-Prince 8(5,3), index 1 with projection, rtol/atol"},
       {"bdf", "implicit BDF of orders 1-5, stabilized index 2 (GGL), rtol/atol"},
   };
   return names;
@@ -325,6 +328,7 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
     return simulate_with<GeneralizedAlpha>(model, ws, s, observe);
   if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);
+  if (s.integrator == "dop853") return simulate_with<DormandPrince853>(model, ws, s, observe);
   if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe);
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
