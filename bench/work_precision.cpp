@@ -90,7 +90,7 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
   for (double h : steps) ladder.push_back({"hht, fixed h", "hht", false, h});
   for (double tol : loose)
     ladder.push_back({"generalized-alpha, adaptive", "generalized-alpha", true, tol});
-  for (const std::string name : {"dopri5", "bdf"})
+  for (const std::string name : {"dopri5", "dop853", "bdf"})
     if (known_integrator(name))
       for (double tol : tight) ladder.push_back({name, name, true, tol});
   if (quick) {  // the ends of each family only

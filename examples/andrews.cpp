@@ -6,8 +6,9 @@
 //
 // The generalized-alpha family runs at a fixed step --h (default 1e-6 s: angles to about 2e-7
 // relative at t = 0.03; 6.25e-8 s gives 1e-9). Its Newton tolerance defaults to 1e-12 here:
-// with steps this short, the library's 1e-9 would add an error of its own per step. dopri5
-// controls its local error by --rtol and --atol instead (--h is then its first step).
+// with steps this short, the library's 1e-9 would add an error of its own per step. dopri5,
+// dop853 and bdf control their local error by --rtol and --atol instead (--h is then the first
+// step).
 
 #include <cstdio>
 #include <cstdlib>
@@ -20,9 +21,10 @@
 namespace {
 
 void usage() {
-  std::cerr << "usage: andrews [--t-end T] [--h STEP] [--dt-out DT] [--out FILE]\n"
-               "               [--integrator generalized-alpha|hht|dopri5] [--rho-inf R]\n"
-               "               [--newton-rtol R] [--rtol R] [--atol A]\n";
+  std::cerr
+      << "usage: andrews [--t-end T] [--h STEP] [--dt-out DT] [--out FILE]\n"
+         "               [--integrator generalized-alpha|hht|dopri5|dop853|bdf] [--rho-inf R]\n"
+         "               [--newton-rtol R] [--rtol R] [--atol A]\n";
 }
 
 double number(const char* option, const char* text) {

@@ -36,7 +36,7 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
   const auto usage = [&] {
     std::cerr << "usage: " << program
               << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
-                 "       [--integrator generalized-alpha|hht|dopri5] [--rho-inf R]\n"
+                 "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf] [--rho-inf R]\n"
                  "       [--rtol R] [--atol A]   (error control: --h is then the first step)\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
