@@ -1,7 +1,8 @@
 // Speed on the flagship engine (shared/specs/engine.md):
 //  - one time step per integrator setting and per saddle-point solver,
 //  - a whole 1 s run with its crank-angle error against the minimal-coordinate reference,
-//  - the evaluation of Phi, Phi_q, M and Q,
+//  - the evaluation of Phi, Phi_q, M and Q, and an explicit stage's parts (evaluations,
+//    saddle-point factorization, solve),
 //  - per-type pools against std::variant dispatch for the same constraint evaluations.
 // Run: build/bench/odyn_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
@@ -104,6 +105,54 @@ void EvaluateBlocks(benchmark::State& state) {
   }
 }
 BENCHMARK(EvaluateBlocks);
+
+/// What an explicit integrator's stage costs, part by part: the evaluations (frames, Phi and
+/// Phi_q, gamma, Q), then the saddle-point factorization with mass terms only, then one solve.
+void StageEvaluations(benchmark::State& state) {
+  engine::Engine e = engine::build();
+  odyn::Workspace<Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  for (auto _ : state) {
+    odyn::update_frames(e.model, ws);
+    odyn::evaluate_constraints(e.model, ws);
+    odyn::evaluate_forces(e.model, ws);
+    odyn::evaluate_gamma(e.model, ws);
+    benchmark::DoNotOptimize(ws.gamma.data());
+    benchmark::DoNotOptimize(ws.force.data());
+  }
+}
+BENCHMARK(StageEvaluations);
+
+template <class Solver>
+void SaddlePointFactorize(benchmark::State& state) {
+  engine::Engine e = engine::build();
+  odyn::Workspace<Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  Solver solver;
+  solver.analyze(e.model);
+  for (auto _ : state) benchmark::DoNotOptimize(solver.factorize(e.model, ws, {}));
+}
+BENCHMARK(SaddlePointFactorize<odyn::BlockSchurSaddlePoint<Model>>);
+BENCHMARK(SaddlePointFactorize<odyn::DenseSaddlePoint<Model>>);
+
+template <class Solver>
+void SaddlePointSolve(benchmark::State& state) {
+  engine::Engine e = engine::build();
+  odyn::Workspace<Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  Solver solver;
+  solver.analyze(e.model);
+  solver.factorize(e.model, ws, {});
+  const Eigen::Index size = e.model.num_velocities() + e.model.num_equations();
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(size, -1.0, 1.0);
+  Eigen::VectorXd solution = Eigen::VectorXd::Zero(size);
+  for (auto _ : state) {
+    solver.solve(rhs, solution);
+    benchmark::DoNotOptimize(solution.data());
+  }
+}
+BENCHMARK(SaddlePointSolve<odyn::BlockSchurSaddlePoint<Model>>);
+BENCHMARK(SaddlePointSolve<odyn::DenseSaddlePoint<Model>>);
 
 /// The same constraint evaluations through per-type pools (the library's way) and through a
 /// vector of std::variant visited element by element.

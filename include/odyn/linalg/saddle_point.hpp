@@ -32,17 +32,19 @@
 // Cholesky of S (the block Schur solver) or LU (the dense one); the rank-revealing
 // factorizations run only when that path finds a singular matrix.
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/linalg/dense_lu.hpp"
+#include "odyn/linalg/small_cholesky.hpp"
 
 namespace odyn {
 
@@ -152,7 +154,7 @@ class BlockSchurSaddlePoint {
  public:
   static constexpr int nv = Model::nv;
   using Block = Eigen::Matrix<double, nv, nv>;
-  using Rows = Eigen::Matrix<double, Eigen::Dynamic, nv>;
+  using Columns = Eigen::Matrix<double, nv, Eigen::Dynamic>;
 
   void analyze(const Model& model) {
     dense_fallback_ = detail::couples_bodies(model);
@@ -165,7 +167,10 @@ class BlockSchurSaddlePoint {
     m_ = model.num_equations();
     blocks_.assign(bodies_, Block::Zero());
     inverses_.assign(bodies_, Block::Zero());
-    // The constraint rows that act on each body: S = B A^-1 B^T only couples those.
+    diagonal_inverse_.assign(bodies_, false);
+    cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
+    // The constraint rows that act on each body, in the order in which for_each_jacobian_block
+    // visits them (pool, element, body): S = B A^-1 B^T only couples those.
     rows_.assign(bodies_, {});
     model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
       if constexpr (Constraint<E>) {
@@ -176,23 +181,26 @@ class BlockSchurSaddlePoint {
                 rows_[body.index - 1].push_back(model.template rows<E>()[i] + r);
       }
     });
-    gathered_.clear();
+    transposed_.clear();
     weighted_.clear();
-    local_.clear();
     for (const auto& rows : rows_) {
       const auto size = static_cast<Eigen::Index>(rows.size());
-      gathered_.emplace_back(Rows::Zero(size, nv));
-      weighted_.emplace_back(Rows::Zero(size, nv));
-      local_.emplace_back(Eigen::MatrixXd::Zero(size, size));
+      transposed_.emplace_back(Columns::Zero(nv, size));
+      weighted_.emplace_back(Columns::Zero(nv, size));
     }
-    jacobian_ = Eigen::MatrixXd::Zero(m_, n_);
+    filled_.assign(bodies_, 0);
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
-    schur_llt_.compute(Eigen::MatrixXd::Identity(m_, m_));  // sizes it; info() defined
+    // Rows couple in S when they share a body: that bounds the envelope of its columns.
+    std::vector<Eigen::Index> envelope_end(static_cast<std::size_t>(m_), 0);
+    for (const auto& rows : rows_)
+      for (const int i : rows)
+        for (const int j : rows)
+          if (i >= j) envelope_end[j] = std::max<Eigen::Index>(envelope_end[j], i + 1);
+    schur_cholesky_.resize(m_, envelope_end);
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
     // Sized (and its info() defined, which UBSan checks on copies) by a first computation.
     if (m_ > 0) schur_eigen_.compute(Eigen::MatrixXd::Identity(m_, m_));
     inverse_eigenvalues_ = Eigen::VectorXd::Zero(m_);
-    work_n_ = Eigen::VectorXd::Zero(n_);
     work_m_ = Eigen::VectorXd::Zero(m_);
     work_eigen_ = Eigen::VectorXd::Zero(m_);
     method_ = Method::cholesky;
@@ -201,36 +209,125 @@ class BlockSchurSaddlePoint {
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     if (dense_fallback_) return dense_.factorize(model, ws, f);
+    if (!invert_blocks(model, ws, f)) return false;
+    // B, body by body: its rows on each body, transposed (one column per constraint row).
+    std::fill(filled_.begin(), filled_.end(), 0);
+    detail::for_each_jacobian_block(model, ws, [&](int, int column, const auto& block) {
+      constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
+      const int b = column / nv;
+      transposed_[b].template middleCols<m>(filled_[b]) = block.transpose();
+      filled_[b] += m;
+    });
+    // S = sum over bodies of B_b A_b^-1 B_b^T, one fixed-size product per pair of rows.
+    schur_.setZero();
+    for (int b = 0; b < bodies_; ++b) {
+      const auto& rows = rows_[b];
+      const Columns& g = transposed_[b];
+      Columns& w = weighted_[b];
+      const auto size = static_cast<Eigen::Index>(rows.size());
+      for (Eigen::Index i = 0; i < size; ++i) {
+        if (diagonal_inverse_[b])  // principal axes at the centre of mass: M_b diagonal
+          w.col(i) = inverses_[b].diagonal().cwiseProduct(g.col(i));
+        else
+          w.col(i).noalias() = inverses_[b] * g.col(i);
+        for (Eigen::Index j = 0; j <= i; ++j) schur_(rows[i], rows[j]) += w.col(i).dot(g.col(j));
+      }
+    }
+    if (m_ == 0) {
+      rank_deficiency_ = 0;
+      return true;
+    }
+    // Rows of one body may come in any order: fill both triangles from the sums.
+    for (Eigen::Index j = 0; j < m_; ++j)
+      for (Eigen::Index i = j + 1; i < m_; ++i) {
+        const double sum = schur_(i, j) + schur_(j, i);
+        schur_(i, j) = sum;
+        schur_(j, i) = sum;
+      }
+    return factorize_schur();
+  }
+
+  /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
+  int rank_deficiency() const {
+    return dense_fallback_ ? dense_.rank_deficiency() : rank_deficiency_;
+  }
+
+  /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    if (dense_fallback_) return dense_.solve(rhs, solution);
+    if (m_ == 0) {
+      for (int b = 0; b < bodies_; ++b)
+        solution.segment<nv>(b * nv).noalias() = inverses_[b] * rhs.segment<nv>(b * nv);
+      return;
+    }
+    // B A^-1 f = sum over bodies of (A_b^-1 B_b^T)^T f_b.
+    work_m_ = -rhs.tail(m_);
+    for (int b = 0; b < bodies_; ++b) {
+      const auto& rows = rows_[b];
+      const Eigen::Matrix<double, nv, 1> f = rhs.segment<nv>(b * nv);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        work_m_[rows[i]] += weighted_[b].col(static_cast<Eigen::Index>(i)).dot(f);
+    }
+    switch (method_) {
+      case Method::cholesky:
+        solution.tail(m_) = work_m_;
+        schur_cholesky_.solve_in_place(solution.tail(m_));
+        break;
+      case Method::lu:
+        solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
+        break;
+      case Method::eigen:  // y = V D^+ V^T r
+        work_eigen_.noalias() = schur_eigen_.eigenvectors().transpose() * work_m_;
+        work_eigen_.array() *= inverse_eigenvalues_.array();
+        solution.tail(m_).noalias() = schur_eigen_.eigenvectors() * work_eigen_;
+        break;
+    }
+    // x_b = A_b^-1 f_b - (A_b^-1 B_b^T) y_b.
+    for (int b = 0; b < bodies_; ++b) {
+      const auto& rows = rows_[b];
+      Eigen::Matrix<double, nv, 1> x = inverses_[b] * rhs.segment<nv>(b * nv);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        x -= weighted_[b].col(static_cast<Eigen::Index>(i)) * solution[n_ + rows[i]];
+      solution.segment<nv>(b * nv) = x;
+    }
+  }
+
+ private:
+  enum class Method { cholesky, lu, eigen };
+
+  /// A_b^-1 for every body. With mass terms only (explicit integrators, projections,
+  /// assembly) A is a multiple of the constant mass matrix: its inverses are kept and reused.
+  bool invert_blocks(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
+    const bool mass_only = f.stiffness == 0.0 && f.damping == 0.0;
+    if (mass_only && f.mass == cached_mass_factor_) return true;
+    cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
+    std::fill(diagonal_inverse_.begin(), diagonal_inverse_.end(), false);
     for (Block& block : blocks_) block.setZero();
     detail::BlockDiagonalView<nv> view{&blocks_};
     add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping);
-    write_jacobian(model, ws, jacobian_, 0, 0, false);
-    schur_.setZero();
     for (int b = 0; b < bodies_; ++b) {
       // Gyroscopic damping makes A slightly unsymmetric; Cholesky then needs its symmetric
       // part, which only slows Newton's convergence a little, never its result.
       inverses_[b] = detail::invert_symmetric<nv>(0.5 * (blocks_[b] + blocks_[b].transpose()));
       if (!inverses_[b].allFinite()) return false;
-      if (rows_[b].empty()) continue;
-      const auto& rows = rows_[b];
-      const auto size = static_cast<Eigen::Index>(rows.size());
-      for (Eigen::Index i = 0; i < size; ++i)
-        gathered_[b].row(i) = jacobian_.block<1, nv>(rows[i], b * nv);
-      weighted_[b].noalias() = gathered_[b] * inverses_[b];
-      local_[b].noalias() = weighted_[b] * gathered_[b].transpose();
-      for (Eigen::Index j = 0; j < size; ++j)
-        for (Eigen::Index i = 0; i < size; ++i) schur_(rows[i], rows[j]) += local_[b](i, j);
     }
+    if (mass_only) {
+      cached_mass_factor_ = f.mass;
+      for (int b = 0; b < bodies_; ++b)
+        diagonal_inverse_[b] = inverses_[b].isDiagonal(0.0);
+    }
+    return true;
+  }
+
+  /// Factorizes the assembled S: Cholesky, else LU, else (singular) its eigen-decomposition.
+  bool factorize_schur() {
     rank_deficiency_ = 0;
-    if (m_ == 0) return true;
     if (!schur_.allFinite()) return false;
     // The fast path: Cholesky. Its pivots are the diagonal of L squared, and the smallest one
     // bounds the smallest eigenvalue of S from above, so a tiny pivot flags a singular S.
-    schur_llt_.compute(schur_);
-    const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
-    if (schur_llt_.info() == Eigen::Success) {
-      const double smallest_pivot = schur_llt_.matrixLLT().diagonal().cwiseAbs2().minCoeff();
-      if (smallest_pivot > rank_tolerance * largest_diagonal) {
+    if (schur_cholesky_.compute(schur_)) {
+      const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
+      if (schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal) {
         method_ = Method::cholesky;
         return true;
       }
@@ -259,59 +356,25 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
-  /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
-  int rank_deficiency() const {
-    return dense_fallback_ ? dense_.rank_deficiency() : rank_deficiency_;
-  }
-
-  /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    if (dense_fallback_) return dense_.solve(rhs, solution);
-    for (int b = 0; b < bodies_; ++b)
-      work_n_.segment<nv>(b * nv).noalias() = inverses_[b] * rhs.segment<nv>(b * nv);
-    if (m_ > 0) {
-      work_m_.noalias() = jacobian_ * work_n_;
-      work_m_ -= rhs.tail(m_);
-      switch (method_) {
-        case Method::cholesky:
-          solution.tail(m_).noalias() = schur_llt_.solve(work_m_);
-          break;
-        case Method::lu:
-          solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
-          break;
-        case Method::eigen:  // y = V D^+ V^T r
-          work_eigen_.noalias() = schur_eigen_.eigenvectors().transpose() * work_m_;
-          work_eigen_.array() *= inverse_eigenvalues_.array();
-          solution.tail(m_).noalias() = schur_eigen_.eigenvectors() * work_eigen_;
-          break;
-      }
-      work_n_.noalias() = rhs.head(n_) - jacobian_.transpose() * solution.tail(m_);
-      for (int b = 0; b < bodies_; ++b)
-        solution.segment<nv>(b * nv).noalias() = inverses_[b] * work_n_.segment<nv>(b * nv);
-    } else {
-      solution.head(n_) = work_n_;
-    }
-  }
-
- private:
-  enum class Method { cholesky, lu, eigen };
   bool dense_fallback_ = false;
   DenseSaddlePoint<Model> dense_;
   int bodies_ = 0, n_ = 0, m_ = 0;
   Method method_ = Method::cholesky;
   int rank_deficiency_ = 0;
-  std::vector<Block> blocks_;              // (nb) diagonal blocks of A
-  std::vector<Block> inverses_;            // (nb) inverses of their symmetric parts
-  std::vector<std::vector<int>> rows_;     // (nb) constraint rows acting on each body
-  std::vector<Rows> gathered_, weighted_;  // (nb) B restricted to those rows, times A^-1
-  std::vector<Eigen::MatrixXd> local_;     // (nb) their contribution to S
-  Eigen::MatrixXd jacobian_;               // (m x n) B
-  Eigen::MatrixXd schur_;                  // (m x m) S = B A^-1 B^T
-  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
+  double cached_mass_factor_ = 0.0;       // NaN unless inverses_ hold (factor M)^-1
+  std::vector<Block> blocks_;             // (nb) diagonal blocks of A
+  std::vector<Block> inverses_;           // (nb) inverses of their symmetric parts
+  std::vector<bool> diagonal_inverse_;    // (nb) inverses_[b] is diagonal (kept mass-only ones)
+  std::vector<std::vector<int>> rows_;    // (nb) constraint rows acting on each body
+  std::vector<int> filled_;               // (nb) columns of transposed_ written so far
+  std::vector<Columns> transposed_;       // (nb) B_b^T: B restricted to the body, transposed
+  std::vector<Columns> weighted_;         // (nb) A_b^-1 B_b^T
+  Eigen::MatrixXd schur_;                 // (m x m) S = B A^-1 B^T
+  SmallCholesky schur_cholesky_;
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> schur_eigen_;  // singular S only
   Eigen::VectorXd inverse_eigenvalues_;  // (m) 1/d_i, or 0 for the null space of S
-  Eigen::VectorXd work_n_, work_m_, work_eigen_;
+  Eigen::VectorXd work_m_, work_eigen_;
 };
 
 }  // namespace odyn

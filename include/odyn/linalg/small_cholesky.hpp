@@ -1,0 +1,109 @@
+#pragma once
+// Cholesky factorization S = L L^T of a small symmetric positive definite matrix with an
+// envelope, for the Schur complements of the saddle-point solver (tens of rows, factorized and
+// solved at every stage of an explicit integrator).
+//
+// Why not Eigen's LLT: it is built for large dense matrices, and at this size its blocked
+// triangular solves spend more time in bookkeeping than in arithmetic. Two things help here:
+//  - the envelope. Column j of S has no entries below row end(j) - 1. In a Schur complement,
+//    rows couple only when their joints share a body, so a chain of joints listed in order
+//    (the engine: revolute, spherical, universal, translational) gives a band: Cholesky keeps
+//    its factor inside the envelope and does a third of the dense work;
+//  - contiguous column updates (axpy) instead of dot products, whose additions would wait on
+//    each other, on L and on a copy of L^T, both column-major; inverses of the pivots stored,
+//    so that no division lies on the solves' chain of dependent operations.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace odyn {
+
+class SmallCholesky {
+ public:
+  /// Sizes the factors for n x n matrices whose column j has no entry below row end[j] - 1
+  /// (end[j] > j; empty: dense). Allocates; compute and solve then do not.
+  void resize(Eigen::Index n, std::vector<Eigen::Index> end = {}) {
+    lower_ = Eigen::MatrixXd::Zero(n, n);
+    upper_ = Eigen::MatrixXd::Zero(n, n);
+    inverse_diagonal_ = Eigen::VectorXd::Zero(n);
+    if (end.empty()) end.assign(static_cast<std::size_t>(n), n);
+    // The factor fills the envelope of the monotone ends; the first row of column i of L^T is
+    // the first column k whose envelope reaches row i.
+    end_.assign(static_cast<std::size_t>(n), 0);
+    begin_.assign(static_cast<std::size_t>(n), 0);
+    Eigen::Index reach = 0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      reach = std::clamp(std::max(reach, end[j]), j + 1, n);
+      end_[j] = reach;
+    }
+    Eigen::Index k = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      while (end_[k] <= i) ++k;
+      begin_[i] = k;
+    }
+  }
+
+  /// Factorizes the symmetric matrix s (its lower triangle within the envelope is read). False
+  /// if a pivot is not positive (s is not positive definite) or not finite.
+  bool compute(const Eigen::MatrixXd& s) {
+    const Eigen::Index n = s.rows();
+    for (Eigen::Index j = 0; j < n; ++j)
+      lower_.col(j).segment(j, end_[j] - j) = s.col(j).segment(j, end_[j] - j);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      double* __restrict column_k = &lower_(0, k);
+      const double pivot = column_k[k];
+      if (!(pivot > 0.0) || !std::isfinite(pivot)) return false;
+      smallest_pivot_ = k == 0 ? pivot : std::min(smallest_pivot_, pivot);
+      const double diagonal = std::sqrt(pivot), inverse = 1.0 / diagonal;
+      column_k[k] = diagonal;
+      inverse_diagonal_[k] = inverse;
+      const Eigen::Index end = end_[k];
+      for (Eigen::Index i = k + 1; i < end; ++i) column_k[i] *= inverse;
+      // The trailing lower triangle loses the outer product of the new column with itself.
+      for (Eigen::Index j = k + 1; j < end; ++j) {
+        double* __restrict column_j = &lower_(0, j);
+        const double l_jk = column_k[j];
+        for (Eigen::Index i = j; i < end; ++i) column_j[i] -= l_jk * column_k[i];
+      }
+    }
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = j; i < end_[j]; ++i) upper_(j, i) = lower_(i, j);
+    return true;
+  }
+
+  /// The smallest pivot L(j, j)^2 of the last successful compute: it bounds the smallest
+  /// eigenvalue of S from above, so a tiny one flags a (nearly) singular matrix.
+  double smallest_pivot() const { return smallest_pivot_; }
+
+  /// x <- S^-1 x.
+  void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) const {
+    const Eigen::Index n = x.size();
+    double* __restrict z = x.data();
+    // L z = x, column by column: z_i /= L(i, i), then z(i+1:end) -= z_i L(i+1:end, i).
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double* __restrict column_i = &lower_(0, i);
+      z[i] *= inverse_diagonal_[i];
+      const double z_i = z[i];
+      for (Eigen::Index k = i + 1; k < end_[i]; ++k) z[k] -= z_i * column_i[k];
+    }
+    // L^T y = z, from the last row: y_i = z_i / U(i, i), then z(begin:i) -= y_i U(begin:i, i).
+    for (Eigen::Index i = n - 1; i >= 0; --i) {
+      const double* __restrict column_i = &upper_(0, i);
+      z[i] *= inverse_diagonal_[i];
+      const double y_i = z[i];
+      for (Eigen::Index k = begin_[i]; k < i; ++k) z[k] -= y_i * column_i[k];
+    }
+  }
+
+ private:
+  Eigen::MatrixXd lower_;                 // L in the lower triangle
+  Eigen::MatrixXd upper_;                 // L^T in the upper triangle
+  Eigen::VectorXd inverse_diagonal_;      // 1 / L(i, i)
+  std::vector<Eigen::Index> end_, begin_;  // envelope: rows [j, end_j) of L's column j, and
+                                           // rows [begin_i, i] of L^T's column i
+  double smallest_pivot_ = 0.0;
+};
+
+}  // namespace odyn
