@@ -9,7 +9,7 @@ rates, and a summary.
 The generalized-alpha family runs at a fixed step --h (default 1e-6 s: angles to about 2e-7
 relative at t = 0.03). Its Newton tolerance defaults to 1e-12 here: with steps this short,
 the library's 1e-9 would add an error of its own per step. --rtol/--atol turn on error control
-(--h is then the first step); dopri5 always controls its error.
+(--h is then the first step); dopri5, dop853 and bdf always control their error.
 """
 
 import argparse

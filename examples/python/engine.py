@@ -7,8 +7,8 @@ examples/engine.json is the same model as a scene file (odyn run examples/engine
                                      [--integrator NAME] [--rho-inf R] [--rtol R] [--atol A]
 
 --rtol/--atol turn on error control for generalized-alpha and hht (--h is then the first
-step), as in the C++ example; dopri5 always controls its error. The command line is shared
-with slider_crank_planar.py (run_command_line).
+step), as in the C++ example; dopri5, dop853 and bdf always control their error. The command
+line is shared with slider_crank_planar.py (run_command_line).
 """
 
 import argparse

@@ -276,8 +276,8 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
     rho_inf) or "hht" take fixed steps of at most `step`, or, with error control (`adaptive`;
     on by default when rtol or atol is given), steps from the local error estimate starting at
-    `step`; "dopri5" (explicit Dormand-Prince 5(4), positions projected onto the constraints to
-    `projection_tolerance`) always controls its error. rtol and atol (default 1e-6) are the
+    `step`; "dopri5" and "dop853" (explicit Dormand-Prince 5(4) and 8(5,3), positions projected
+    onto the constraints to `projection_tolerance`) and "bdf" always control their error. rtol and atol (default 1e-6) are the
     local error tolerances per component of (q, v); max_step bounds an adaptive step.
     newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
     iteration of generalized-alpha and hht.

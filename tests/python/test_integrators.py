@@ -46,7 +46,7 @@ def exact_angle():
 def test_the_names_come_from_the_cpp_library():
     names = odyn.integrators()
     assert list(names) == [n for n, _ in odyn._core.integrators()]
-    assert {"generalized-alpha", "hht", "dopri5"} <= set(names)
+    assert {"generalized-alpha", "hht", "dopri5", "dop853"} <= set(names)
     assert all(isinstance(what, str) and what for what in names.values())
 
 
@@ -89,9 +89,10 @@ def test_generalized_alpha_fixed_and_adaptive(exact_angle):
     np.testing.assert_allclose(hht.body("bob").angle, exact_angle, atol=1e-4)
 
 
-def test_max_step_bounds_an_adaptive_step():
-    free = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.5, integrator="dopri5")
-    bounded = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.5, integrator="dopri5",
+@pytest.mark.parametrize("name", ["dopri5", "dop853"])
+def test_max_step_bounds_an_adaptive_step(name):
+    free = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.5, integrator=name)
+    bounded = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.5, integrator=name,
                             max_step=1e-3)
     assert free.statistics.steps < 1000 <= bounded.statistics.steps
 
