@@ -313,8 +313,7 @@ class BlockSchurSaddlePoint {
     }
     if (mass_only) {
       cached_mass_factor_ = f.mass;
-      for (int b = 0; b < bodies_; ++b)
-        diagonal_inverse_[b] = inverses_[b].isDiagonal(0.0);
+      for (int b = 0; b < bodies_; ++b) diagonal_inverse_[b] = inverses_[b].isDiagonal(0.0);
     }
     return true;
   }
@@ -361,15 +360,15 @@ class BlockSchurSaddlePoint {
   int bodies_ = 0, n_ = 0, m_ = 0;
   Method method_ = Method::cholesky;
   int rank_deficiency_ = 0;
-  double cached_mass_factor_ = 0.0;       // NaN unless inverses_ hold (factor M)^-1
-  std::vector<Block> blocks_;             // (nb) diagonal blocks of A
-  std::vector<Block> inverses_;           // (nb) inverses of their symmetric parts
-  std::vector<bool> diagonal_inverse_;    // (nb) inverses_[b] is diagonal (kept mass-only ones)
-  std::vector<std::vector<int>> rows_;    // (nb) constraint rows acting on each body
-  std::vector<int> filled_;               // (nb) columns of transposed_ written so far
-  std::vector<Columns> transposed_;       // (nb) B_b^T: B restricted to the body, transposed
-  std::vector<Columns> weighted_;         // (nb) A_b^-1 B_b^T
-  Eigen::MatrixXd schur_;                 // (m x m) S = B A^-1 B^T
+  double cached_mass_factor_ = 0.0;     // NaN unless inverses_ hold (factor M)^-1
+  std::vector<Block> blocks_;           // (nb) diagonal blocks of A
+  std::vector<Block> inverses_;         // (nb) inverses of their symmetric parts
+  std::vector<bool> diagonal_inverse_;  // (nb) inverses_[b] is diagonal (kept mass-only ones)
+  std::vector<std::vector<int>> rows_;  // (nb) constraint rows acting on each body
+  std::vector<int> filled_;             // (nb) columns of transposed_ written so far
+  std::vector<Columns> transposed_;     // (nb) B_b^T: B restricted to the body, transposed
+  std::vector<Columns> weighted_;       // (nb) A_b^-1 B_b^T
+  Eigen::MatrixXd schur_;               // (m x m) S = B A^-1 B^T
   SmallCholesky schur_cholesky_;
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> schur_eigen_;  // singular S only

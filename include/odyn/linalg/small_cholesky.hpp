@@ -98,9 +98,9 @@ class SmallCholesky {
   }
 
  private:
-  Eigen::MatrixXd lower_;                 // L in the lower triangle
-  Eigen::MatrixXd upper_;                 // L^T in the upper triangle
-  Eigen::VectorXd inverse_diagonal_;      // 1 / L(i, i)
+  Eigen::MatrixXd lower_;                  // L in the lower triangle
+  Eigen::MatrixXd upper_;                  // L^T in the upper triangle
+  Eigen::VectorXd inverse_diagonal_;       // 1 / L(i, i)
   std::vector<Eigen::Index> end_, begin_;  // envelope: rows [j, end_j) of L's column j, and
                                            // rows [begin_i, i] of L^T's column i
   double smallest_pivot_ = 0.0;
