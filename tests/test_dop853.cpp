@@ -96,10 +96,12 @@ TEST_CASE("dop853: a large-amplitude pendulum against its elliptic-integral solu
     const auto errors = pendulum.run(with_tolerance("dop853", 1e-12));
     INFO("end " << errors.end << ", quarters " << errors.quarters << ", steps "
                 << errors.summary.statistics.steps);
-    // Measured: 1.1e-13 at T, 1.9e-12 at the quarters, in 91 steps.
+    // Measured: 2.4e-14 at T, 4.4e-15 at the quarters, in 280 steps. (Hairer's blend of the
+    // fifth- and third-order estimates took 91 steps for 1.1e-13 here, but misjudged the
+    // engine's power stroke: see dop853.hpp.)
     CHECK(errors.end < 1e-12);
     CHECK(errors.quarters < 1e-11);
-    CHECK(errors.summary.statistics.steps < 120);
+    CHECK(errors.summary.statistics.steps < 350);
     CHECK(errors.summary.max_position_residual < 1e-12);
   }
   SECTION("order 8: halving a fixed step divides the error by about 2^8") {

@@ -46,8 +46,8 @@ struct DormandPrinceSettings {
 ///   b[s]: y_{n+1} = y_n + h sum b_i k_i, unless last_stage_is_new_point (first same as last:
 ///     the last stage sits at y_{n+1}, so the solver already holds the matrix there);
 ///   error_weights[s]: h sum e_i k_i estimates the local error, of order error_order + 1 in h;
-///     with low_order_error_weights as well, the two estimates combine as in Hairer's dop853;
 ///   min_step_factor, max_step_factor: bounds of the step-size change;
+///   stabilization_exponent: beta of the PI step control (0: plain I control);
 ///   extra_stages, extra_c, extra_a[e][s + 1 + e]: stages only the dense output needs;
 ///   dense_rows, dense[r][s + 1 + extra_stages]: the continuous extension (see dense_state).
 template <class M>
@@ -61,6 +61,7 @@ concept ExplicitRungeKuttaMethod = requires {
   { M::last_stage_is_new_point } -> std::convertible_to<bool>;
   { M::min_step_factor } -> std::convertible_to<double>;
   { M::max_step_factor } -> std::convertible_to<double>;
+  { M::stabilization_exponent } -> std::convertible_to<double>;
   M::c[0] + M::a[0][0] + M::b[0] + M::error_weights[0] + M::dense[0][0];
 };
 
@@ -188,12 +189,24 @@ class ExplicitRungeKutta {
   /// Local error of the last attempt in units of the tolerance (accept when <= 1).
   double error_norm() const { return error_; }
 
-  /// Accepts the last attempt and proposes the next step from its error.
+  /// Accepts the last attempt and proposes the next step from its error and, with
+  /// stabilization_exponent > 0, the previous step's error (PI control, Hairer, Norsett &
+  /// Wanner, Sect. IV.2): fewer rejections where the error changes quickly. No growth right
+  /// after a rejection.
   void accept() {
     commit();
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
-    const double grown = h_ * step_factor(error_, Method::error_order, Method::min_step_factor,
-                                          Method::max_step_factor);
+    constexpr double beta = Method::stabilization_exponent;
+    constexpr double alpha = 1.0 / (Method::error_order + 1) - 0.75 * beta;
+    double factor = Method::max_step_factor;
+    if (error_ > 0.0)
+      factor = std::clamp(0.9 * std::pow(error_, -alpha) * std::pow(previous_error_, beta),
+                          Method::min_step_factor, Method::max_step_factor);
+    if (!std::isfinite(factor)) factor = Method::min_step_factor;
+    if (rejected_) factor = std::min(factor, 1.0);
+    previous_error_ = std::max(error_, 1e-4);
+    rejected_ = false;
+    const double grown = h_ * factor;
     // A step cut short to land on an output time says nothing against the longer step.
     proposed_step_ =
         std::min(control_.max_step, h_ < proposed_step_ ? std::max(proposed_step_, grown) : grown);
@@ -202,6 +215,7 @@ class ExplicitRungeKutta {
   /// Rejects the last attempt and shrinks the step; throws once it is hopelessly short.
   void reject() {
     ++statistics_.rejected_steps;
+    rejected_ = true;
     proposed_step_ =
         h_ * std::min(0.9, step_factor(error_, Method::error_order, Method::min_step_factor, 0.9));
     rollback();
@@ -283,19 +297,10 @@ class ExplicitRungeKutta {
       if (weights[j] != 0.0) out.noalias() += (h * weights[j]) * k_[j];
   }
 
-  /// The local error of the step to y_new_ in units of the tolerance. With a second, lower-order
-  /// estimate (dop853), err5^2 / sqrt(err5^2 + 0.01 err3^2): the fifth-order estimate, kept
-  /// from being too optimistic at large steps by the third-order one (Hairer's dop853).
+  /// The local error of the step to y_new_ in units of the tolerance.
   double estimate_error(double h) {
     combine(stage_, h, Method::error_weights, s);
-    double error = weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
-    if constexpr (requires { Method::low_order_error_weights; }) {
-      combine(stage_, h, Method::low_order_error_weights, s);
-      const double low = weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
-      const double denominator = std::sqrt(error * error + 0.01 * low * low);
-      error = denominator > 0.0 ? error * error / denominator : 0.0;
-    }
-    return error;
+    return weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
   }
 
   /// f(t, y): the configuration rate and v' (index 1) at a stage; leaves v' and lambda in the
@@ -439,6 +444,8 @@ class ExplicitRungeKutta {
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, size_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0, proposed_step_ = 1e-4;
+  double previous_error_ = 1e-4;  // of the last accepted step, for PI control
+  bool rejected_ = false;         // the last attempt was rejected
   Eigen::VectorXd y_n_, y_new_, stage_, rhs_, solution_, velocity_residual_, vdot_n_, lambda_n_;
   // Stage derivatives of the last attempt, f at its projected end, the extra dense stages.
   std::array<Eigen::VectorXd, num_derivatives> k_;

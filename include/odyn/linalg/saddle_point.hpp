@@ -181,13 +181,16 @@ class BlockSchurSaddlePoint {
                 rows_[body.index - 1].push_back(model.template rows<E>()[i] + r);
       }
     });
-    transposed_.clear();
-    weighted_.clear();
-    for (const auto& rows : rows_) {
-      const auto size = static_cast<Eigen::Index>(rows.size());
-      transposed_.emplace_back(Columns::Zero(nv, size));
-      weighted_.emplace_back(Columns::Zero(nv, size));
+    // One flat list of (body, row) entries, body after body: column k of the matrices below.
+    entry_rows_.clear();
+    body_begin_.assign(bodies_ + 1, 0);
+    for (int b = 0; b < bodies_; ++b) {
+      entry_rows_.insert(entry_rows_.end(), rows_[b].begin(), rows_[b].end());
+      body_begin_[b + 1] = static_cast<int>(entry_rows_.size());
     }
+    const auto entries = static_cast<Eigen::Index>(entry_rows_.size());
+    transposed_ = Columns::Zero(nv, entries);
+    weighted_ = Columns::Zero(nv, entries);
     filled_.assign(bodies_, 0);
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
     // Rows couple in S when they share a body: that bounds the envelope of its columns.
@@ -211,39 +214,36 @@ class BlockSchurSaddlePoint {
     if (dense_fallback_) return dense_.factorize(model, ws, f);
     if (!invert_blocks(model, ws, f)) return false;
     // B, body by body: its rows on each body, transposed (one column per constraint row).
-    std::fill(filled_.begin(), filled_.end(), 0);
+    std::copy(body_begin_.begin(), body_begin_.end() - 1, filled_.begin());
     detail::for_each_jacobian_block(model, ws, [&](int, int column, const auto& block) {
       constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
       const int b = column / nv;
-      transposed_[b].template middleCols<m>(filled_[b]) = block.transpose();
+      transposed_.template middleCols<m>(filled_[b]) = block.transpose();
       filled_[b] += m;
     });
     // S = sum over bodies of B_b A_b^-1 B_b^T, one fixed-size product per pair of rows.
     schur_.setZero();
     for (int b = 0; b < bodies_; ++b) {
-      const auto& rows = rows_[b];
-      const Columns& g = transposed_[b];
-      Columns& w = weighted_[b];
-      const auto size = static_cast<Eigen::Index>(rows.size());
-      for (Eigen::Index i = 0; i < size; ++i) {
-        if (diagonal_inverse_[b])  // principal axes at the centre of mass: M_b diagonal
-          w.col(i) = inverses_[b].diagonal().cwiseProduct(g.col(i));
+      const Block& inverse = inverses_[b];
+      const bool diagonal = diagonal_inverse_[b];  // principal axes at the centre of mass
+      for (int i = body_begin_[b]; i < body_begin_[b + 1]; ++i) {
+        if (diagonal)
+          weighted_.col(i) = inverse.diagonal().cwiseProduct(transposed_.col(i));
         else
-          w.col(i).noalias() = inverses_[b] * g.col(i);
-        for (Eigen::Index j = 0; j <= i; ++j) schur_(rows[i], rows[j]) += w.col(i).dot(g.col(j));
+          weighted_.col(i).noalias() = inverse * transposed_.col(i);
+        // Into the lower triangle (rows of one body may come in any order).
+        const int row_i = entry_rows_[i];
+        for (int j = body_begin_[b]; j <= i; ++j) {
+          const int row_j = entry_rows_[j];
+          schur_(std::max(row_i, row_j), std::min(row_i, row_j)) +=
+              weighted_.col(i).dot(transposed_.col(j));
+        }
       }
     }
     if (m_ == 0) {
       rank_deficiency_ = 0;
       return true;
     }
-    // Rows of one body may come in any order: fill both triangles from the sums.
-    for (Eigen::Index j = 0; j < m_; ++j)
-      for (Eigen::Index i = j + 1; i < m_; ++i) {
-        const double sum = schur_(i, j) + schur_(j, i);
-        schur_(i, j) = sum;
-        schur_(j, i) = sum;
-      }
     return factorize_schur();
   }
 
@@ -263,10 +263,9 @@ class BlockSchurSaddlePoint {
     // B A^-1 f = sum over bodies of (A_b^-1 B_b^T)^T f_b.
     work_m_ = -rhs.tail(m_);
     for (int b = 0; b < bodies_; ++b) {
-      const auto& rows = rows_[b];
       const Eigen::Matrix<double, nv, 1> f = rhs.segment<nv>(b * nv);
-      for (std::size_t i = 0; i < rows.size(); ++i)
-        work_m_[rows[i]] += weighted_[b].col(static_cast<Eigen::Index>(i)).dot(f);
+      for (int k = body_begin_[b]; k < body_begin_[b + 1]; ++k)
+        work_m_[entry_rows_[k]] += weighted_.col(k).dot(f);
     }
     switch (method_) {
       case Method::cholesky:
@@ -283,11 +282,11 @@ class BlockSchurSaddlePoint {
         break;
     }
     // x_b = A_b^-1 f_b - (A_b^-1 B_b^T) y_b.
+    const double* y = solution.data() + n_;
     for (int b = 0; b < bodies_; ++b) {
-      const auto& rows = rows_[b];
       Eigen::Matrix<double, nv, 1> x = inverses_[b] * rhs.segment<nv>(b * nv);
-      for (std::size_t i = 0; i < rows.size(); ++i)
-        x -= weighted_[b].col(static_cast<Eigen::Index>(i)) * solution[n_ + rows[i]];
+      for (int k = body_begin_[b]; k < body_begin_[b + 1]; ++k)
+        x -= weighted_.col(k) * y[entry_rows_[k]];
       solution.segment<nv>(b * nv) = x;
     }
   }
@@ -321,16 +320,18 @@ class BlockSchurSaddlePoint {
   /// Factorizes the assembled S: Cholesky, else LU, else (singular) its eigen-decomposition.
   bool factorize_schur() {
     rank_deficiency_ = 0;
+    // The fast path: Cholesky on the lower triangle. Its pivots are the diagonal of L squared,
+    // and the smallest one bounds the smallest eigenvalue of S from above, so a tiny pivot flags
+    // a singular S. A non-finite entry reaches a pivot and fails it.
+    const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
+    const bool positive_definite = schur_cholesky_.compute(schur_);
+    if (positive_definite && schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal) {
+      method_ = Method::cholesky;
+      return true;
+    }
     if (!schur_.allFinite()) return false;
-    // The fast path: Cholesky. Its pivots are the diagonal of L squared, and the smallest one
-    // bounds the smallest eigenvalue of S from above, so a tiny pivot flags a singular S.
-    if (schur_cholesky_.compute(schur_)) {
-      const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
-      if (schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal) {
-        method_ = Method::cholesky;
-        return true;
-      }
-    } else {
+    schur_.triangularView<Eigen::StrictlyUpper>() = schur_.transpose();
+    if (!positive_definite) {
       // Not positive definite (A itself is not): LU on the same matrix, if it is regular.
       schur_lu_.compute(schur_);
       const double largest = schur_lu_.matrixLU().cwiseAbs().maxCoeff();
@@ -365,9 +366,11 @@ class BlockSchurSaddlePoint {
   std::vector<Block> inverses_;         // (nb) inverses of their symmetric parts
   std::vector<bool> diagonal_inverse_;  // (nb) inverses_[b] is diagonal (kept mass-only ones)
   std::vector<std::vector<int>> rows_;  // (nb) constraint rows acting on each body
-  std::vector<int> filled_;             // (nb) columns of transposed_ written so far
-  std::vector<Columns> transposed_;     // (nb) B_b^T: B restricted to the body, transposed
-  std::vector<Columns> weighted_;       // (nb) A_b^-1 B_b^T
+  std::vector<int> entry_rows_;         // the rows of rows_, body after body (entries)
+  std::vector<int> body_begin_;         // (nb + 1) each body's first entry
+  std::vector<int> filled_;             // (nb) next entry of each body to write
+  Columns transposed_;                  // (entries) B_b^T, the rows of B on body b, transposed
+  Columns weighted_;                    // (entries) A_b^-1 B_b^T
   Eigen::MatrixXd schur_;               // (m x m) S = B A^-1 B^T
   SmallCholesky schur_cholesky_;
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
