@@ -166,12 +166,7 @@ class ExplicitRungeKutta {
   void interpolate_frames(double t) {
     if (!prepare_dense_output()) fail();
     dense_state(t);
-    ws_.t = t;
-    ws_.q = y_dense_.head(nq_total_);
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = y_dense_.tail(nv_total_);
-    update_frames(model_, ws_);
+    load_state(t, y_dense_);
   }
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
@@ -303,16 +298,21 @@ class ExplicitRungeKutta {
     return weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
   }
 
-  /// f(t, y): the configuration rate and v' (index 1) at a stage; leaves v' and lambda in the
-  /// workspace. False if the saddle-point matrix is singular or a value is not finite.
-  bool derivative(double t, const Eigen::VectorXd& y, Eigen::VectorXd& k) {
-    ++statistics_.residual_evaluations;
+  /// The workspace at (t, y): q with unit quaternions, v, and the frames from them.
+  void load_state(double t, const Eigen::VectorXd& y) {
     ws_.t = t;
     ws_.q = y.head(nq_total_);
     for (int b = 0; b < model_.num_bodies(); ++b)
       Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
     ws_.v = y.tail(nv_total_);
     update_frames(model_, ws_);
+  }
+
+  /// f(t, y): the configuration rate and v' (index 1) at a stage; leaves v' and lambda in the
+  /// workspace. False if the saddle-point matrix is singular or a value is not finite.
+  bool derivative(double t, const Eigen::VectorXd& y, Eigen::VectorXd& k) {
+    ++statistics_.residual_evaluations;
+    load_state(t, y);
     evaluate_constraints(model_, ws_);
     if (!accelerations()) return false;
     for (int b = 0; b < model_.num_bodies(); ++b)
@@ -387,12 +387,7 @@ class ExplicitRungeKutta {
   /// whose v' and lambda then carry a relative error of the size of the correction but feed
   /// nothing back into the integration.
   bool project(double t, const Eigen::VectorXd& y, HeldMatrix held, bool output_point = false) {
-    ws_.t = t;
-    ws_.q = y.head(nq_total_);
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = y.tail(nv_total_);
-    update_frames(model_, ws_);
+    load_state(t, y);
     evaluate_constraints(model_, ws_);
     bool matrix_at_positions = held == HeldMatrix::at_point;
     if (held == HeldMatrix::none) {

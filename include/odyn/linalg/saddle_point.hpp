@@ -171,21 +171,21 @@ class BlockSchurSaddlePoint {
     cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
     // The constraint rows that act on each body, in the order in which for_each_jacobian_block
     // visits them (pool, element, body): S = B A^-1 B^T only couples those.
-    rows_.assign(bodies_, {});
+    std::vector<std::vector<int>> rows(bodies_);
     model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
       if constexpr (Constraint<E>) {
         for (std::size_t i = 0; i < pool.size(); ++i)
           for (const BodyId body : pool[i].bodies())
             if (!body.is_ground())
               for (int r = 0; r < E::num_equations; ++r)
-                rows_[body.index - 1].push_back(model.template rows<E>()[i] + r);
+                rows[body.index - 1].push_back(model.template rows<E>()[i] + r);
       }
     });
     // One flat list of (body, row) entries, body after body: column k of the matrices below.
     entry_rows_.clear();
     body_begin_.assign(bodies_ + 1, 0);
     for (int b = 0; b < bodies_; ++b) {
-      entry_rows_.insert(entry_rows_.end(), rows_[b].begin(), rows_[b].end());
+      entry_rows_.insert(entry_rows_.end(), rows[b].begin(), rows[b].end());
       body_begin_[b + 1] = static_cast<int>(entry_rows_.size());
     }
     const auto entries = static_cast<Eigen::Index>(entry_rows_.size());
@@ -195,9 +195,9 @@ class BlockSchurSaddlePoint {
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
     // Rows couple in S when they share a body: that bounds the envelope of its columns.
     std::vector<Eigen::Index> envelope_end(static_cast<std::size_t>(m_), 0);
-    for (const auto& rows : rows_)
-      for (const int i : rows)
-        for (const int j : rows)
+    for (const auto& body_rows : rows)
+      for (const int i : body_rows)
+        for (const int j : body_rows)
           if (i >= j) envelope_end[j] = std::max<Eigen::Index>(envelope_end[j], i + 1);
     schur_cholesky_.resize(m_, envelope_end);
     schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
@@ -365,8 +365,7 @@ class BlockSchurSaddlePoint {
   std::vector<Block> blocks_;           // (nb) diagonal blocks of A
   std::vector<Block> inverses_;         // (nb) inverses of their symmetric parts
   std::vector<bool> diagonal_inverse_;  // (nb) inverses_[b] is diagonal (kept mass-only ones)
-  std::vector<std::vector<int>> rows_;  // (nb) constraint rows acting on each body
-  std::vector<int> entry_rows_;         // the rows of rows_, body after body (entries)
+  std::vector<int> entry_rows_;         // constraint rows acting on each body, body after body
   std::vector<int> body_begin_;         // (nb + 1) each body's first entry
   std::vector<int> filled_;             // (nb) next entry of each body to write
   Columns transposed_;                  // (entries) B_b^T, the rows of B on body b, transposed
