@@ -25,36 +25,60 @@ bash scripts/setup.sh
 # Each test compiles once: the Catch2 suite in the sanitizer build, the rest (examples for the
 # Python twins, the allocation count, the installed package) in Release. Templates make each
 # translation unit cost tens of seconds, so nothing is built twice; .ci/run adds the benchmarks.
+# Single-threaded steps (a test run, the one-file downstream build) run beside others, so that
+# neither core idles.
+trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
+
+# finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
+finish() {
+  local rc=0
+  wait "$1" || rc=$?
+  cat "$2"
+  if ((rc != 0)); then echo "test.sh: $3 failed (exit $rc)" >&2; exit "$rc"; fi
+}
+
 section "ASan + UBSan build of the tests (build-asan/)"
 # -Og -g1 (line tables: enough for sanitizer stack traces) compiles twice as fast as -O1 -g here.
 configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 
-section "ASan + UBSan tests"
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
-export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-ctest --test-dir build-asan --output-on-failure -j "$jobs"
-unset ASAN_OPTIONS UBSAN_OPTIONS
-
-section "Release build: examples and the allocation test (build/)"
+section "Release build (build/), with the ASan + UBSan tests and the downstream build beside it"
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
+asan_log=build-asan/odyn_tests.log
+(
+  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+  export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+  ctest --test-dir build-asan --output-on-failure
+) >"$asan_log" 2>&1 &
+asan_pid=$!
+# The library is header-only: the configured tree installs before anything is built.
+rm -rf build/install build/downstream
+cmake --install build --prefix build/install >/dev/null
+downstream_log=build/downstream.log
+(
+  launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
+    -DCMAKE_PREFIX_PATH="$root/build/install"
+  cmake --build build/downstream -j 1
+  ./build/downstream/odyn_downstream
+) >"$downstream_log" 2>&1 &
+downstream_pid=$!
 cmake --build build -j "$jobs" --target odyn_allocation_tests engine slider_crank_planar \
   four_bar andrews
-ctest --test-dir build --output-on-failure -R '^odyn_allocation_tests$'
+
+section "ASan + UBSan tests"
+finish "$asan_pid" "$asan_log" "the ASan + UBSan tests"
 
 section "Install + downstream find_package(odyn)"
-rm -rf build/install build/downstream
-cmake --install build --prefix build/install
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
-  -DCMAKE_PREFIX_PATH="$root/build/install"
-cmake --build build/downstream -j "$jobs"
-./build/downstream/odyn_downstream
+finish "$downstream_pid" "$downstream_log" "the downstream build"
 
-# Python tests (bindings come later): run pytest only where test files exist.
+section "Release: allocation test"
+ctest --test-dir build --output-on-failure -R '^odyn_allocation_tests$'
+
+# Python tests: the twins of the C++ examples and of the downstream program need the above.
 py_dirs=()
 for d in python/tests tests/python; do
   if [[ -d $d ]] && find "$d" -name 'test_*.py' -o -name '*_test.py' | grep -q .; then

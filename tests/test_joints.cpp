@@ -483,4 +483,16 @@ TEST_CASE("Drivers assembled together with the joint they drive", "[joints]") {
   }
 }
 
+TEST_CASE("quaternion_exp agrees with Eigen's angle-axis rotation at every size", "[rotation]") {
+  // Small angles take a Taylor series, larger ones sin and cos: both within a few ulps.
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  for (const double angle : {0.0, 1e-12, 1e-6, 1e-3, 0.05, 0.199, 0.2, 0.201, 1.0, 3.0, 7.0}) {
+    const Eigen::Quaterniond expected(Eigen::AngleAxisd(angle, axis));
+    const Eigen::Quaterniond q = odyn::quaternion_exp(angle * axis);
+    CAPTURE(angle);
+    CHECK((q.coeffs() - expected.coeffs()).cwiseAbs().maxCoeff() < 4e-16);
+    CHECK(std::abs(q.norm() - 1.0) < 4e-16);
+  }
+}
+
 }  // namespace test_joints
