@@ -18,22 +18,10 @@ inline Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
 inline Eigen::Quaterniond quaternion_exp(const Eigen::Vector3d& rotation_vector) {
   const double angle = rotation_vector.norm();
   const double half = 0.5 * angle;
-  double cos_half, sin_half_over_angle;
-  if (half < 0.1) {
-    // The increments of a time step: Taylor series of cos(x) and sin(x)/x to x^8, whose
-    // remainders (x^10/10!, x^10/11!) stay below half an ulp of 1 here, with no library call
-    // and no 0/0 at zero.
-    const double x2 = half * half;
-    cos_half = 1.0 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320))));
-    const double sinc_half =
-        1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880))));
-    sin_half_over_angle = 0.5 * sinc_half;
-  } else {
-    cos_half = std::cos(half);
-    sin_half_over_angle = std::sin(half) / angle;
-  }
-  return {cos_half, sin_half_over_angle * rotation_vector.x(),
-          sin_half_over_angle * rotation_vector.y(), sin_half_over_angle * rotation_vector.z()};
+  // sin(x)/x by its Taylor series near zero avoids 0/0 for tiny increments.
+  const double sinc_half = angle < 1e-4 ? 0.5 - angle * angle / 48.0 : std::sin(half) / angle;
+  return {std::cos(half), sinc_half * rotation_vector.x(), sinc_half * rotation_vector.y(),
+          sinc_half * rotation_vector.z()};
 }
 
 /// Any unit vector perpendicular to the unit vector `axis` (deterministic choice).

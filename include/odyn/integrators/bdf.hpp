@@ -197,7 +197,7 @@ class Bdf {
     output_solver_.solve(rhs_, solution_);
     ws_.vdot = solution_.head(nv_total_);
     ws_.lambda = solution_.tail(m_);
-    return all_finite(ws_.q) && all_finite(ws_.v) && all_finite(solution_);
+    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
   }
 
   /// Positions and velocities at t from the last attempt's polynomial, and the frames.
@@ -508,7 +508,7 @@ class Bdf {
     jacobian_times(model_, ws_, ws_.v, velocity_residual_);
     velocity_residual_ += ws_.phi_t;
     rhs_.tail(m_) = -velocity_residual_;
-    return all_finite(rhs_) && all_finite(ws_.phi);
+    return rhs_.allFinite() && ws_.phi.allFinite();
   }
 
   bool factorize() {

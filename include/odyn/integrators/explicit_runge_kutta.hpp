@@ -319,7 +319,7 @@ class ExplicitRungeKutta {
       k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
           y.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
     k.tail(nv_total_) = ws_.vdot;
-    return all_finite(k);
+    return k.allFinite();
   }
 
   /// The derivative at the workspace's (consistent) state, whose v' is already solved.
@@ -340,7 +340,7 @@ class ExplicitRungeKutta {
     solver_.solve(rhs_, solution_);
     ws_.vdot = solution_.head(nv_total_);
     ws_.lambda = solution_.tail(m_);
-    return all_finite(solution_);
+    return solution_.allFinite();
   }
 
   bool factorize() {
@@ -428,7 +428,7 @@ class ExplicitRungeKutta {
     solver_.solve(rhs_, solution_);
     ws_.vdot = solution_.head(nv_total_);
     ws_.lambda = solution_.tail(m_);
-    return all_finite(ws_.q) && all_finite(ws_.v) && all_finite(solution_);
+    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
   }
 
   const Model& model_;

@@ -49,13 +49,6 @@ struct StepControl {
   double min_step = 1e-14;  // s; below this a step is hopeless and the run stops
 };
 
-/// True if every entry is finite: a NaN or an infinity anywhere makes the sum NaN or infinite
-/// (finite entries could overflow it only near 1e308, far beyond any sane state). One
-/// vectorized pass, where Eigen's allFinite compares entry by entry.
-inline bool all_finite(const Eigen::Ref<const Eigen::VectorXd>& x) {
-  return std::isfinite(x.sum());
-}
-
 /// The weighted root-mean-square norm of a local error estimate:
 /// sqrt(mean((e_i / (atol + rtol max(|a_i|, |b_i|)))^2)), the norm of DASSL and of Hairer's codes.
 inline double weighted_rms_norm(const Eigen::Ref<const Eigen::VectorXd>& error,
