@@ -171,13 +171,7 @@ class ExplicitRungeKutta {
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
   void restore_trial() {
-    ws_.t = t_n_ + h_;
-    ws_.q = y_trial_.head(nq_total_);
-    ws_.v = y_trial_.tail(nv_total_);
-    ws_.vdot = vdot_trial_;
-    ws_.lambda = lambda_trial_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    load_solved_state(t_n_ + h_, y_trial_, vdot_trial_, lambda_trial_);
     evaluate_forces(model_, ws_);
   }
 
@@ -234,15 +228,7 @@ class ExplicitRungeKutta {
   }
 
   /// Puts the workspace back at the last committed state.
-  void rollback() {
-    ws_.t = t_n_;
-    ws_.q = y_n_.head(nq_total_);
-    ws_.v = y_n_.tail(nv_total_);
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-  }
+  void rollback() { load_solved_state(t_n_, y_n_, vdot_n_, lambda_n_); }
 
   [[noreturn]] void fail() {
     const double t_failed = t_n_ + h_;
@@ -296,6 +282,18 @@ class ExplicitRungeKutta {
   double estimate_error(double h) {
     combine(stage_, h, Method::error_weights, s);
     return weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
+  }
+
+  /// The workspace at a projected state (t, y) with its v' and lambda: frames and constraints.
+  void load_solved_state(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& vdot,
+                         const Eigen::VectorXd& lambda) {
+    ws_.t = t;
+    ws_.q = y.head(nq_total_);
+    ws_.v = y.tail(nv_total_);
+    ws_.vdot = vdot;
+    ws_.lambda = lambda;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
   }
 
   /// The workspace at (t, y): q with unit quaternions, v, and the frames from them.
