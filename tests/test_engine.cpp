@@ -157,4 +157,45 @@ TEST_CASE("planar slider-crank: the engine in 9 coordinates", "[engine][planar]"
   }
 }
 
+// Not the engine, but its model type (spatial Rsda among its elements), so that no other model
+// is compiled: a torsion spring wound past half a turn. Its energy must follow the unwrapped
+// angle theta(t) = A sin(w t), w = sqrt(k / J), with A = 1.5 pi; the angle within one turn
+// would give 1/2 k (pi/2)^2 instead of 1/2 k (3 pi/2)^2 at the peak.
+TEST_CASE("spatial RSDA: potential energy of a spring wound past half a turn", "[rsda]") {
+  using Eigen::Vector3d;
+  namespace sp = odyn::spatial;
+  const double inertia = 0.5, k = 2.0, omega = std::sqrt(k / inertia);
+  const double amplitude = 1.5 * std::numbers::pi, spin = amplitude * omega;
+  engine::Model model;
+  sp::Body rotor{.name = "rotor", .mass = 1.0, .inertia = sp::Body::principal(inertia, 0.3, 0.3)};
+  rotor.angular_velocity = {spin, 0.0, 0.0};
+  const odyn::BodyId body = model.add_body(rotor);
+  const Vector3d x = Vector3d::UnitX();
+  model.add(sp::Revolute("axle", odyn::ground, sp::JointFrame{{0, 0, 0}, x}, body,
+                         sp::JointFrame{{0, 0, 0}, x}));
+  model.add(sp::Rsda("torsion", odyn::ground, sp::JointFrame{{0, 0, 0}, x}, body,
+                     sp::JointFrame{{0, 0, 0}, x}, {.stiffness = k}));
+  odyn::Workspace<engine::Model> ws(model);
+  odyn::DynamicsSettings settings;
+  settings.step = 1e-3;
+  settings.t_end = 1.6;  // past the peak at t = pi / 4 and back through pi at 1.2 s
+  settings.output_interval = 1e-3;
+  const double energy0 = 0.5 * inertia * spin * spin;
+  double max_potential_error = 0.0, max_energy_change = 0.0, peak = 0.0;
+  odyn::simulate(model, ws, settings, [&](const auto& w) {
+    const double theta = amplitude * std::sin(omega * w.t);
+    const double potential = odyn::potential_energy(model, w);
+    max_potential_error =
+        std::max(max_potential_error, std::abs(potential - 0.5 * k * theta * theta));
+    max_energy_change =
+        std::max(max_energy_change, std::abs(odyn::kinetic_energy(model, w) + potential - energy0));
+    peak = std::max(peak, potential);
+  });
+  INFO("energy " << energy0 << " J, peak potential " << peak << " J");
+  // Generalized-alpha at w h = 2e-3: a phase error of about (w h)^2 / 12 per radian.
+  CHECK(max_potential_error < 1e-4 * energy0);
+  CHECK(max_energy_change < 1e-4 * energy0);
+  CHECK(peak == Approx(energy0).epsilon(1e-4));
+}
+
 }  // namespace test_engine

@@ -260,11 +260,15 @@ double kinetic_energy(const Model& model, const Workspace<Model>& ws) {
 template <class Model>
 double potential_energy(const Model& model, const Workspace<Model>& ws) {
   double energy = 0.0;
-  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
     if constexpr (FieldForce<E>) {
       for (const E& field : pool)
         for (int b = 1; b <= model.num_bodies(); ++b)
           energy += field.potential_energy(model.body(BodyId{b}).mass, ws.frames[b]);
+    } else if constexpr (HasStatefulPotential<E>) {
+      const auto& states = std::get<type>(ws.states);
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        energy += pool[i].potential_energy(detail::input_of(pool[i], ws.frames, ws.t), states[i]);
     } else if constexpr (HasPotential<E>) {
       for (const E& element : pool)
         energy += element.potential_energy(detail::input_of(element, ws.frames, ws.t));

@@ -123,6 +123,14 @@ concept HasPotential = requires(const E& e, const InputOf<E>& in) {
   { e.potential_energy(in) } -> std::convertible_to<double>;
 };
 
+/// Optional: a stateful force element whose potential energy also reads its state (a spring
+/// that counts turns, for instance).
+template <class E>
+concept HasStatefulPotential = StatefulForce<E> &&
+    requires(const E& e, const InputOf<E>& in, const typename E::State& s) {
+  { e.potential_energy(in, s) } -> std::convertible_to<double>;
+};
+
 /// Optional: an element that completes its own description from the bodies' initial frames
 /// (for example a reference direction the user left out). Called once, when it is added.
 template <class E>

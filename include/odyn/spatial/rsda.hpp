@@ -49,10 +49,14 @@ class Rsda : public PairJoint {
   double rate(const Input& in) const { return direction(in).dot(velocities(in)); }
 
   void evaluate(const Input& in, const State& state, ForceBlocks<Space, 2>& out) const {
-    const double theta = angle(in, state), theta_rate = rate(in);
+    const Eigen::Matrix<double, 12, 1> e = direction(in);
+    const double theta_rate = e.dot(velocities(in));
+    // The angle (an atan2) only for a spring or an actuator: a pure damper, such as the engine's
+    // load, runs in every residual evaluation.
+    const bool needs_angle = p_.stiffness != 0.0 || static_cast<bool>(p_.actuator);
+    const double theta = needs_angle ? angle(in, state) : 0.0;
     const double torque = -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
                           (p_.actuator ? p_.actuator(in.t, theta, theta_rate) : 0.0);
-    const Eigen::Matrix<double, 12, 1> e = direction(in);
     out.force[0] = torque * e.head<6>();
     out.force[1] = torque * e.tail<6>();
   }
@@ -63,9 +67,9 @@ class Rsda : public PairJoint {
     out.damping = p_.damping * e * e.transpose();
   }
 
-  double potential_energy(const Input& in) const {
-    // The spring's energy needs the unwrapped angle; this uses the angle within a turn.
-    const double stretch = wrapped_angle(in) - p_.free_angle;
+  /// The spring's energy at the unwrapped angle, so that it stays continuous past +-pi.
+  double potential_energy(const Input& in, const State& state) const {
+    const double stretch = angle(in, state) - p_.free_angle;
     return 0.5 * p_.stiffness * stretch * stretch;
   }
 
