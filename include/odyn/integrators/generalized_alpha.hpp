@@ -137,6 +137,11 @@ class GeneralizedAlpha {
     else
       a_step_ = a_n_;
     const double t_new = t_n_ + h;
+    if (h < 1e-3 * reference_step_) {
+      taylor_step(t_new);
+      estimate_error();
+      return true;
+    }
     for (int attempt = 0; attempt < 2; ++attempt) {
       const bool fresh = !factorized_;
       if (solve_step(t_new)) {
@@ -193,6 +198,14 @@ class GeneralizedAlpha {
     t_n_ = ws_.t;
     advance_states(model_, ws_);
     ++statistics_.steps;
+    // A step far shorter than the recent ones (one that lands on an output time just after a
+    // switch of the forces, say) corrects Phi in a tiny time: the correction is an impulse of
+    // order Phi / h^2 in v' and a, which the following steps would carry on and turn into
+    // velocity errors (|Phi_q v| up to 0.4 in long engine runs, or a divergence). Starting
+    // afresh from the committed state, as after a switch, removes it.
+    const bool short_step = h_ < 0.1 * reference_step_;
+    reference_step_ = std::max(h_, 0.5 * reference_step_);
+    if (short_step) restart();
   }
 
   /// Restarts after a discontinuity of the forces (and at the start of a run): v' and lambda
@@ -288,6 +301,27 @@ class GeneralizedAlpha {
     ws_.t = t_new;
   }
 
+  /// A step of less than a thousandth of the recent ones: the motion continued by its Taylor
+  /// expansion, v' and lambda kept. Phi changes by about h |Phi_q v + Phi_t| (tens of
+  /// picometres), which the next regular step corrects, where a Newton correction here would
+  /// be an impulse of order Phi / h^2; commit() then restarts with v' and lambda solved at the
+  /// new state.
+  void taylor_step(double t_new) {
+    const double h = h_;
+    increment_ = h * v_n_ + (0.5 * h * h) * vdot_n_;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::integrate(q_n_.template segment<nq>(b * nq),
+                              increment_.template segment<nv>(b * nv),
+                              ws_.q.template segment<nq>(b * nq));
+    ws_.v = v_n_ + h * vdot_n_;
+    ws_.vdot = vdot_n_;
+    ws_.lambda = lambda_n_;
+    ws_.t = t_new;
+    update_frames(model_, ws_);
+    evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+  }
+
   /// Residual of the step equations at the workspace's state; false if it is not finite.
   bool evaluate_residual() {
     ++statistics_.residual_evaluations;
@@ -345,14 +379,13 @@ class GeneralizedAlpha {
       // Converged when Phi is satisfied and the last correction, or the next one as estimated
       // from the residual, is within tolerance.
       // The next correction is estimated from the residual with the mass matrix's diagonal.
+      // A predictor that meets both already stands (a step of a few nanoseconds, where any
+      // correction of Phi would be an impulse of order Phi / h^2).
       const double next_norm =
-          k > 0 ? velocity_factor() *
-                      (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_))
-                          .cwiseAbs()
-                          .maxCoeff() /
-                      (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff())
-                : 0.0;
-      if (k > 0 && (previous_norm <= 1.0 || next_norm <= 1.0) &&
+          velocity_factor() *
+          (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_)).cwiseAbs().maxCoeff() /
+          (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff());
+      if (((k > 0 && previous_norm <= 1.0) || next_norm <= 1.0) &&
           (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
         if (k > settings_.reuse_iterations) factorized_ = false;
         return true;
@@ -405,10 +438,11 @@ class GeneralizedAlpha {
   Eigen::VectorXd q_n_, v_n_, vdot_n_, a_n_, lambda_n_;  // state at the start of the step
   Eigen::VectorXd vdot_previous_, lambda_previous_;      // one step earlier, for the predictor
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start
-  Eigen::VectorXd inverse_mass_diagonal_;                // (nv_total)
-  Eigen::VectorXd jerk_;                                 // (nv_total) v'' at the last restart
-  bool starting_ = false;       // the next step is the first after a restart
-  Eigen::VectorXd increment_;   // (nv_total) configuration increment
+  double reference_step_ = 0.0;  // the recent steps' size: max(h, half the last reference)
+  Eigen::VectorXd inverse_mass_diagonal_;  // (nv_total)
+  Eigen::VectorXd jerk_;                   // (nv_total) v'' at the last restart
+  bool starting_ = false;                  // the next step is the first after a restart
+  Eigen::VectorXd increment_;              // (nv_total) configuration increment
   Eigen::VectorXd a_step_;      // (nv_total) a_n shifted to the size of the attempted step
   Eigen::VectorXd a_previous_;  // (nv_total) a_{n-1}
   Eigen::VectorXd local_error_, error_scale_;  // (nv_total)
