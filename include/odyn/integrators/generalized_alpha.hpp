@@ -220,10 +220,7 @@ class GeneralizedAlpha {
     // A short Taylor step along the motion, then v'' by a finite difference.
     const double delta = 1e-6 * std::max(std::abs(t_n_), 1.0) + (h_ > 0.0 ? 1e-2 * h_ : 0.0);
     increment_ = delta * v_n_ + 0.5 * delta * delta * vdot_n_;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::integrate(q_n_.template segment<nq>(b * nq),
-                              increment_.template segment<nv>(b * nv),
-                              ws_.q.template segment<nq>(b * nq));
+    move_positions();
     ws_.v = v_n_ + delta * vdot_n_;
     ws_.t = t_n_ + delta;
     consistent_accelerations();
@@ -294,11 +291,16 @@ class GeneralizedAlpha {
         ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / one_minus_am;
     ws_.v = v_n_ + h * (1.0 - gamma_) * a_step_ + h * gamma_ * increment_;
     increment_ = h * v_n_ + h * h * (0.5 - beta_) * a_step_ + h * h * beta_ * increment_;
+    move_positions();
+    ws_.t = t_new;
+  }
+
+  /// ws.q = q_n moved by increment_ (translations added, rotations composed on the right).
+  void move_positions() {
     for (int b = 0; b < model_.num_bodies(); ++b)
       Model::Space::integrate(q_n_.template segment<nq>(b * nq),
                               increment_.template segment<nv>(b * nv),
                               ws_.q.template segment<nq>(b * nq));
-    ws_.t = t_new;
   }
 
   /// A step of less than a thousandth of the recent ones: the motion continued by its Taylor
@@ -309,10 +311,7 @@ class GeneralizedAlpha {
   void taylor_step(double t_new) {
     const double h = h_;
     increment_ = h * v_n_ + (0.5 * h * h) * vdot_n_;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::integrate(q_n_.template segment<nq>(b * nq),
-                              increment_.template segment<nv>(b * nv),
-                              ws_.q.template segment<nq>(b * nq));
+    move_positions();
     ws_.v = v_n_ + h * vdot_n_;
     ws_.vdot = vdot_n_;
     ws_.lambda = lambda_n_;
