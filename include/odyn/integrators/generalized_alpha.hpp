@@ -378,13 +378,14 @@ class GeneralizedAlpha {
       // Converged when Phi is satisfied and the last correction, or the next one as estimated
       // from the residual, is within tolerance.
       // The next correction is estimated from the residual with the mass matrix's diagonal.
-      // A predictor that meets both already stands (a step of a few nanoseconds, where any
-      // correction of Phi would be an impulse of order Phi / h^2).
       const double next_norm =
-          velocity_factor() *
-          (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_)).cwiseAbs().maxCoeff() /
-          (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff());
-      if (((k > 0 && previous_norm <= 1.0) || next_norm <= 1.0) &&
+          k > 0 ? velocity_factor() *
+                      (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_))
+                          .cwiseAbs()
+                          .maxCoeff() /
+                      (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff())
+                : 0.0;
+      if (k > 0 && (previous_norm <= 1.0 || next_norm <= 1.0) &&
           (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
         if (k > settings_.reuse_iterations) factorized_ = false;
         return true;
