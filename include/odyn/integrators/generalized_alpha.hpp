@@ -137,7 +137,7 @@ class GeneralizedAlpha {
     else
       a_step_ = a_n_;
     const double t_new = t_n_ + h;
-    if (h < 1e-3 * reference_step_) {
+    if (h < 1e-3 * usual_step()) {
       taylor_step(t_new);
       estimate_error();
       return true;
@@ -198,12 +198,12 @@ class GeneralizedAlpha {
     t_n_ = ws_.t;
     advance_states(model_, ws_);
     ++statistics_.steps;
-    // A step far shorter than the recent ones (one that lands on an output time just after a
+    // A step far shorter than the usual one (one that lands on an output time just after a
     // switch of the forces, say) corrects Phi in a tiny time: the correction is an impulse of
     // order Phi / h^2 in v' and a, which the following steps would carry on and turn into
     // velocity errors (|Phi_q v| up to 0.4 in long engine runs, or a divergence). Starting
     // afresh from the committed state, as after a switch, removes it.
-    const bool short_step = h_ < 0.1 * reference_step_;
+    const bool short_step = h_ < 0.1 * usual_step();
     reference_step_ = std::max(h_, 0.5 * reference_step_);
     if (short_step) restart();
   }
@@ -295,6 +295,11 @@ class GeneralizedAlpha {
     ws_.t = t_new;
   }
 
+  /// The step size that steps far shorter than it are measured against: the one that the
+  /// error control proposes, or in fixed steps the recent steps' size. (A step that the error
+  /// control shrank is not short: it is what the control asked for.)
+  double usual_step() const { return settings_.adaptive ? proposed_step_ : reference_step_; }
+
   /// ws.q = q_n moved by increment_ (translations added, rotations composed on the right).
   void move_positions() {
     for (int b = 0; b < model_.num_bodies(); ++b)
@@ -303,11 +308,11 @@ class GeneralizedAlpha {
                               ws_.q.template segment<nq>(b * nq));
   }
 
-  /// A step of less than a thousandth of the recent ones: the motion continued by its Taylor
+  /// A step of less than a thousandth of the usual one: the motion continued by its Taylor
   /// expansion, v' and lambda kept. Phi changes by about h |Phi_q v + Phi_t| (tens of
-  /// picometres), which the next regular step corrects, where a Newton correction here would
-  /// be an impulse of order Phi / h^2; commit() then restarts with v' and lambda solved at the
-  /// new state.
+  /// picometres on the engine), which the next regular step corrects, where a Newton
+  /// correction here would be an impulse of order Phi / h^2; commit() then restarts with v'
+  /// and lambda solved at the new state.
   void taylor_step(double t_new) {
     const double h = h_;
     increment_ = h * v_n_ + (0.5 * h * h) * vdot_n_;
