@@ -101,7 +101,7 @@ class SmallCholesky {
   }
 
  private:
-  Eigen::MatrixXd lower_;                  // L below the diagonal (its unit diagonal not stored)
+  Eigen::MatrixXd lower_;                  // L below the diagonal, the pivots D on it
   Eigen::MatrixXd upper_;                  // L^T above the diagonal
   Eigen::VectorXd inverse_diagonal_;       // 1 / D(i, i)
   std::vector<Eigen::Index> end_, begin_;  // envelope: rows [j, end_j) of L's column j, and
