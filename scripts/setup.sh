@@ -1,8 +1,13 @@
 #!/usr/bin/env bash
 # Installs what odyn needs on Debian 12 and prepares .venv. Idempotent: when everything is already
 # there it touches neither apt nor pip.
+#   bash scripts/setup.sh                 everything, the odyn Python package included
+#   bash scripts/setup.sh --no-package    the dependencies only (test.sh builds the package
+#                                         beside its C++ builds)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
+package=1
+[[ ${1:-} == --no-package ]] && package=0
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config git ca-certificates
@@ -43,14 +48,18 @@ if ! .venv/bin/python -c 'import numpy, pytest, matplotlib' >/dev/null 2>&1; the
   .venv/bin/python -m pip install -q --disable-pip-version-check numpy pytest matplotlib
 fi
 
-# --- The Python package odyn (pip install .) -----------------------------------------------------
-# Built with the venv's scikit-build-core and pybind11 (no build isolation: no download per build)
-# in build-python/, so a rebuild compiles only what changed; skipped when the sources are those of
-# the last install.
+# The package's build backend: the venv's scikit-build-core and pybind11 (no build isolation, so
+# no download per build).
 if ! .venv/bin/python -c 'import scikit_build_core, pybind11' >/dev/null 2>&1; then
   echo "setup.sh: installing scikit-build-core pybind11 into .venv"
   .venv/bin/python -m pip install -q --disable-pip-version-check scikit-build-core pybind11
 fi
+
+((package)) || exit 0
+
+# --- The Python package odyn (pip install .) -----------------------------------------------------
+# Built in build-python/, so a rebuild compiles only what changed; skipped when the sources are
+# those of the last install.
 stamp=.venv/odyn-sources.sha256
 sources=$(find pyproject.toml CMakeLists.txt cmake include python examples/engine_model.hpp \
             -type f ! -name '*.pyc' -print0 | sort -z | xargs -0 sha256sum | sha256sum)

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Full check: ASan/UBSan build + Catch2 tests, Release examples + allocation test, install +
-# downstream consumer, Python tests. Exits non-zero on the first failure.
+# Full check: ASan/UBSan build + Catch2 tests (allocation count included), Release examples,
+# install + downstream consumer, the Python package and its tests. Exits non-zero on the first
+# failure.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=$PWD
@@ -20,13 +21,13 @@ configure() {
 }
 
 section "Setup"
-bash scripts/setup.sh
+bash scripts/setup.sh --no-package
 
-# Each test compiles once: the Catch2 suite in the sanitizer build, the rest (examples for the
-# Python twins, the allocation count, the installed package) in Release. Templates make each
-# translation unit cost tens of seconds, so nothing is built twice; .ci/run adds the benchmarks.
-# Single-threaded steps (a test run, the one-file downstream build) run beside others, so that
-# neither core idles.
+# Each test compiles once: the Catch2 suite in the sanitizer build, the examples (the C++ twins
+# of the Python tests) and the installed package's consumer in Release, and the Python package.
+# Template instantiation makes each translation unit cost tens of seconds of CPU, so the builds
+# run side by side and keep both cores busy: the Python package beside the sanitizer build, the
+# test run and the one-file downstream build beside the Release build.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -37,13 +38,19 @@ finish() {
   if ((rc != 0)); then echo "test.sh: $3 failed (exit $rc)" >&2; exit "$rc"; fi
 }
 
+section "Python package (pip install .), built beside the C++ builds"
+mkdir -p build
+python_log=build/python-package.log
+CMAKE_BUILD_PARALLEL_LEVEL=$jobs bash scripts/setup.sh >"$python_log" 2>&1 &
+python_pid=$!
+
 section "ASan + UBSan build of the tests (build-asan/)"
 # -Og -g1 (line tables: enough for sanitizer stack traces) compiles twice as fast as -O1 -g here.
 configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 
-section "Release build (build/), with the ASan + UBSan tests and the downstream build beside it"
+section "Release build of the examples (build/); the ASan + UBSan tests and downstream beside it"
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
 asan_log=build-asan/odyn_tests.log
@@ -66,17 +73,16 @@ downstream_log=build/downstream.log
   ./build/downstream/odyn_downstream
 ) >"$downstream_log" 2>&1 &
 downstream_pid=$!
-cmake --build build -j "$jobs" --target odyn_allocation_tests engine slider_crank_planar \
-  four_bar andrews
+cmake --build build -j "$jobs" --target engine slider_crank_planar four_bar andrews
 
-section "ASan + UBSan tests"
+section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
 finish "$asan_pid" "$asan_log" "the ASan + UBSan tests"
 
 section "Install + downstream find_package(odyn)"
 finish "$downstream_pid" "$downstream_log" "the downstream build"
 
-section "Release: allocation test"
-ctest --test-dir build --output-on-failure -R '^odyn_allocation_tests$'
+section "Python package"
+finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
 
 # Python tests: the twins of the C++ examples and of the downstream program need the above.
 py_dirs=()

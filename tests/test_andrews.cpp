@@ -34,7 +34,7 @@ Run run(double h, double newton_rtol = 1e-12) {
   const double phi1_start = m.model.body(m.bodies[0]).angle;
   const double v0 = andrews_reference::kSpecSpringEnergy0;
   Run result;
-  odyn::simulate(m.model, ws, settings, [&](const Workspace& state) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(m.model, ws, settings, [&](const Workspace& state) {
     const double energy =
         odyn::kinetic_energy(m.model, state) + odyn::potential_energy(m.model, state) -
         andrews_reference::kMotorTorque * (state.frames[m.bodies[0].index].angle - phi1_start);

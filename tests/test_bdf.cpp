@@ -37,7 +37,7 @@ double andrews_error(double tolerance, odyn::RunSummary* summary = nullptr) {
   settings.step = 1e-6;
   settings.t_end = 0.03;
   settings.output_interval = 1e-3;
-  const auto result = odyn::simulate(m.model, ws, settings, [](const auto&) {});
+  const auto result = odyn::simulate_with<odyn::Bdf>(m.model, ws, settings, [](const auto&) {});
   if (summary) *summary = result;
   const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
   double error = 0.0;
@@ -129,10 +129,11 @@ TEST_CASE("bdf: the engine through its switches", "[bdf][engine]") {
     odyn::Workspace<typename decltype(e)::Model> ws(e.model);
     std::size_t k = 0;
     double z_error = 0.0;
-    const auto summary = odyn::simulate(e.model, ws, bdf(tolerance), [&](const auto& state) {
-      z_error =
-          std::max(z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
-    });
+    const auto summary =
+        odyn::simulate_with<odyn::Bdf>(e.model, ws, bdf(tolerance), [&](const auto& state) {
+          z_error = std::max(
+              z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
+        });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     INFO("tolerance " << tolerance << ": theta error " << theta_error << " rad, z error " << z_error
                       << " m, steps " << summary.statistics.steps << ", rejected "
@@ -154,7 +155,7 @@ TEST_CASE("bdf: the engine through its switches", "[bdf][engine]") {
 
 TEST_CASE("bdf: heavy symmetric top in steady precession", "[bdf][pendulums]") {
   // Against the gyroscope equation; a spatial body whose quaternion BDF carries as four numbers.
-  const auto top = steady_top::run(bdf(1e-10));
+  const auto top = steady_top::run<odyn::Bdf>(bdf(1e-10));
   INFO("tilt error " << top.tilt_error << ", spin error " << top.spin_error << ", precession "
                      << top.azimuth << " vs " << top.precession_rate << ", steps "
                      << top.summary.statistics.steps);
@@ -183,13 +184,13 @@ TEST_CASE("bdf: bad settings and a hopeless step are reported by name", "[bdf][e
   auto e = engine::planar::build();
   odyn::Workspace<engine::planar::Model> ws(e.model);
   SECTION("tolerances") {
-    CHECK_THROWS_WITH(odyn::simulate(e.model, ws, bdf(-1.0), [](const auto&) {}),
+    CHECK_THROWS_WITH(odyn::simulate_with<odyn::Bdf>(e.model, ws, bdf(-1.0), [](const auto&) {}),
                       Catch::Contains("rtol"));
   }
   SECTION("order") {
     odyn::DynamicsSettings settings = bdf(1e-6);
     settings.bdf.max_order = 7;
-    CHECK_THROWS_WITH(odyn::simulate(e.model, ws, settings, [](const auto&) {}),
+    CHECK_THROWS_WITH(odyn::simulate_with<odyn::Bdf>(e.model, ws, settings, [](const auto&) {}),
                       Catch::Contains("max_order"));
   }
   SECTION("a force that turns to NaN") {
@@ -201,7 +202,7 @@ TEST_CASE("bdf: bad settings and a hopeless step are reported by name", "[bdf][e
     odyn::DynamicsSettings settings = bdf(1e-8);
     settings.t_end = 0.1;
     try {
-      odyn::simulate(s.model, stiff_ws, settings, [](const auto&) {});
+      odyn::simulate_with<odyn::Bdf>(s.model, stiff_ws, settings, [](const auto&) {});
       FAIL("no error");
     } catch (const odyn::SolverError& error) {
       CHECK_THAT(error.what(), Catch::Contains("bdf") && Catch::Contains("'broken'"));

@@ -73,16 +73,19 @@ struct Pendulum {
     settings.output_interval = period / 4.0;
     Errors errors;
     int quarter = 0;
-    errors.summary = odyn::simulate(model, ws, settings, [&](const auto& state) {
-      const double angle = state.q[2], rate = state.v[2];
-      const double expected_angle = quarter % 2 == 1 ? 0.0 : (quarter == 2 ? -theta0 : theta0);
-      const double expected_rate = quarter == 1 ? -bottom_speed : quarter == 3 ? bottom_speed : 0.0;
-      const double error =
-          std::max(std::abs(angle - expected_angle), std::abs(rate - expected_rate));
-      if (quarter < 4) errors.quarters = std::max(errors.quarters, error);
-      if (quarter == 4) errors.end = error;
-      ++quarter;
-    });
+    errors.summary =
+        odyn::simulate_with<odyn::DormandPrince853>(model, ws, settings, [&](const auto& state) {
+          const double angle = state.q[2], rate = state.v[2];
+          const double expected_angle = quarter % 2 == 1 ? 0.0 : (quarter == 2 ? -theta0 : theta0);
+          const double expected_rate = quarter == 1   ? -bottom_speed
+                                       : quarter == 3 ? bottom_speed
+                                                      : 0.0;
+          const double error =
+              std::max(std::abs(angle - expected_angle), std::abs(rate - expected_rate));
+          if (quarter < 4) errors.quarters = std::max(errors.quarters, error);
+          if (quarter == 4) errors.end = error;
+          ++quarter;
+        });
     return errors;
   }
 };
@@ -133,7 +136,8 @@ TEST_CASE("dop853: Andrews' mechanism to ten digits", "[dop853][andrews]") {
     settings.step = 1e-6;
     settings.t_end = 0.03;
     settings.output_interval = 1e-3;
-    const auto summary = odyn::simulate(m.model, ws, settings, [](const auto&) {});
+    const auto summary =
+        odyn::simulate_with<odyn::DormandPrince853>(m.model, ws, settings, [](const auto&) {});
     CHECK(summary.max_position_residual < 1e-11);
     CHECK(summary.max_velocity_residual < 1e-11);
     const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
@@ -157,8 +161,8 @@ TEST_CASE("dop853: the engine through its switches, outputs interpolated", "[dop
     odyn::Workspace<typename decltype(e)::Model> ws(e.model);
     std::size_t k = 0;
     double z_error = 0.0;
-    const auto summary =
-        odyn::simulate(e.model, ws, with_tolerance("dop853", 1e-11), [&](const auto& state) {
+    const auto summary = odyn::simulate_with<odyn::DormandPrince853>(
+        e.model, ws, with_tolerance("dop853", 1e-11), [&](const auto& state) {
           z_error = std::max(
               z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
         });
@@ -180,7 +184,7 @@ TEST_CASE("dop853: the engine through its switches, outputs interpolated", "[dop
 }
 
 TEST_CASE("dop853: heavy symmetric top in steady precession", "[dop853][pendulums]") {
-  const auto top = steady_top::run(with_tolerance("dop853", 1e-11));
+  const auto top = steady_top::run<odyn::DormandPrince853>(with_tolerance("dop853", 1e-11));
   INFO("tilt error " << top.tilt_error << ", precession " << top.azimuth << " vs "
                      << top.precession_rate);
   CHECK(top.tilt_error < 1e-8);
@@ -223,7 +227,8 @@ TEST_CASE("dop853: known by name, bad tolerances refused by name", "[dop853][err
                     [](const auto& entry) { return entry.first == "dop853"; }));
   auto e = engine::planar::build();
   odyn::Workspace<engine::planar::Model> ws(e.model);
-  CHECK_THROWS_WITH(odyn::simulate(e.model, ws, with_tolerance("dop853", -1.0), [](const auto&) {}),
+  CHECK_THROWS_WITH(odyn::simulate_with<odyn::DormandPrince853>(
+                        e.model, ws, with_tolerance("dop853", -1.0), [](const auto&) {}),
                     Catch::Contains("rtol"));
 }
 

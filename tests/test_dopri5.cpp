@@ -36,7 +36,8 @@ TEST_CASE("dopri5: Andrews' mechanism to ten digits", "[dopri5][andrews]") {
     settings.step = 1e-6;
     settings.t_end = 0.03;
     settings.output_interval = 1e-3;
-    const auto summary = odyn::simulate(m.model, ws, settings, [](const auto&) {});
+    const auto summary =
+        odyn::simulate_with<odyn::DormandPrince>(m.model, ws, settings, [](const auto&) {});
     CHECK(summary.max_position_residual < 1e-11);
     CHECK(summary.max_velocity_residual < 1e-11);
     const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
@@ -57,10 +58,11 @@ TEST_CASE("dopri5: the engine through its switches", "[dopri5][engine]") {
     odyn::Workspace<typename decltype(e)::Model> ws(e.model);
     std::size_t k = 0;
     double z_error = 0.0;
-    const auto summary = odyn::simulate(e.model, ws, dopri5(1e-10), [&](const auto& state) {
-      z_error =
-          std::max(z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
-    });
+    const auto summary = odyn::simulate_with<odyn::DormandPrince>(
+        e.model, ws, dopri5(1e-10), [&](const auto& state) {
+          z_error = std::max(
+              z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
+        });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     INFO("theta error " << theta_error << " rad, z error " << z_error << " m, steps "
                         << summary.statistics.steps);
@@ -78,7 +80,7 @@ TEST_CASE("dopri5: the engine through its switches", "[dopri5][engine]") {
 TEST_CASE("dopri5: heavy symmetric top in steady precession", "[dopri5][pendulums]") {
   // Against the gyroscope equation; the quaternion is integrated as four numbers and
   // renormalized.
-  const auto top = steady_top::run(dopri5(1e-11));
+  const auto top = steady_top::run<odyn::DormandPrince>(dopri5(1e-11));
   INFO("tilt error " << top.tilt_error << ", precession " << top.azimuth << " vs "
                      << top.precession_rate);
   CHECK(top.tilt_error < 1e-8);
@@ -91,8 +93,9 @@ TEST_CASE("dopri5: bad tolerances are refused by name", "[dopri5][errors]") {
   auto e = engine::planar::build();
   odyn::Workspace<engine::planar::Model> ws(e.model);
   odyn::DynamicsSettings settings = dopri5(-1.0);
-  CHECK_THROWS_WITH(odyn::simulate(e.model, ws, settings, [](const auto&) {}),
-                    Catch::Contains("rtol"));
+  CHECK_THROWS_WITH(
+      odyn::simulate_with<odyn::DormandPrince>(e.model, ws, settings, [](const auto&) {}),
+      Catch::Contains("rtol"));
 }
 
 }  // namespace test_dopri5

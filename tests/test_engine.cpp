@@ -31,7 +31,7 @@ Errors run(Build build, double h, double t_end,
   settings.output_interval = 1e-3;
   Errors errors;
   std::size_t k = 0;
-  odyn::simulate(e.model, ws, settings, [&](const auto& state) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(e.model, ws, settings, [&](const auto& state) {
     const auto& ref = reference.at(k++);
     REQUIRE(state.t == Approx(ref.t).margin(1e-12));
     const auto [phi, phid] = odyn::constraint_residuals(e.model, state);
@@ -169,19 +169,22 @@ TEST_CASE("planar slider-crank: the engine in 9 coordinates", "[engine][planar]"
     settings.t_end = 1.0;
     settings.output_interval = 1e-3;
     std::vector<std::array<double, 3>> planar_outputs;
-    odyn::simulate(planar.model, ws_planar, settings, [&](const auto& state) {
-      planar_outputs.push_back({engine::crank_angle(planar, state),
-                                engine::piston_height(planar, state),
-                                engine::bearing_force_z(planar, state)});
-    });
+    odyn::simulate_with<odyn::GeneralizedAlpha>(
+        planar.model, ws_planar, settings, [&](const auto& state) {
+          planar_outputs.push_back({engine::crank_angle(planar, state),
+                                    engine::piston_height(planar, state),
+                                    engine::bearing_force_z(planar, state)});
+        });
     std::size_t k = 0;
     double theta = 0.0, z = 0.0, reaction = 0.0;
-    odyn::simulate(spatial.model, ws_spatial, settings, [&](const auto& state) {
-      const auto& other = planar_outputs.at(k++);
-      theta = std::max(theta, std::abs(engine::crank_angle(spatial, state) - other[0]));
-      z = std::max(z, std::abs(engine::piston_height(spatial, state) - other[1]));
-      reaction = std::max(reaction, std::abs(engine::bearing_force_z(spatial, state) - other[2]));
-    });
+    odyn::simulate_with<odyn::GeneralizedAlpha>(
+        spatial.model, ws_spatial, settings, [&](const auto& state) {
+          const auto& other = planar_outputs.at(k++);
+          theta = std::max(theta, std::abs(engine::crank_angle(spatial, state) - other[0]));
+          z = std::max(z, std::abs(engine::piston_height(spatial, state) - other[1]));
+          reaction =
+              std::max(reaction, std::abs(engine::bearing_force_z(spatial, state) - other[2]));
+        });
     // Measured: 7.6e-7 rad, 3.2e-8 m, 1.0 N; against the reference both are off by 5e-4 rad,
     // 2e-5 m and 25 N.
     CHECK(k == planar_outputs.size());
@@ -216,7 +219,7 @@ TEST_CASE("spatial RSDA: potential energy of a spring wound past half a turn", "
   settings.output_interval = 1e-3;
   const double energy0 = 0.5 * inertia * spin * spin;
   double max_potential_error = 0.0, max_energy_change = 0.0, peak = 0.0;
-  odyn::simulate(model, ws, settings, [&](const auto& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const auto& w) {
     const double theta = amplitude * std::sin(omega * w.t);
     const double potential = odyn::potential_energy(model, w);
     max_potential_error =

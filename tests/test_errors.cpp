@@ -346,7 +346,8 @@ TEST_CASE("Over-constrained mechanism: the redundant joints are named, and it ru
   Workspace run(model);
   run.v[5] = 2.0;  // swinging about the hinge axis at 2 rad/s
   odyn::RunSummary summary;
-  REQUIRE_NOTHROW(summary = odyn::simulate(model, run, short_run(), [](const Workspace&) {}));
+  REQUIRE_NOTHROW(summary = odyn::simulate_with<odyn::GeneralizedAlpha>(model, run, short_run(),
+                                                                        [](const Workspace&) {}));
   REQUIRE(summary.redundant_equations.size() == 5);
   for (const odyn::RedundantEquation& e : summary.redundant_equations) {
     INFO(e.text());
@@ -371,7 +372,8 @@ TEST_CASE("Over-constrained mechanism whose constraints contradict each other", 
   Model model = two_hinged_door(0.25);
   Workspace ws(model);
   REQUIRE_THROWS_MATCHES(
-      odyn::simulate(model, ws, short_run(), [](const Workspace&) {}), odyn::AssemblyError,
+      odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, short_run(), [](const Workspace&) {}),
+      odyn::AssemblyError,
       AssemblyErrorAbout(
           "hinge", {"could not be satisfied", "largest residual", "upper hinge", "lower hinge"}));
 }
@@ -427,7 +429,8 @@ TEST_CASE("A force that returns NaN during a run", "[errors]") {
   const odyn::DynamicsSettings settings = short_run();
   double last_output = -1.0;
   try {
-    odyn::simulate(bob.model, ws, settings, [&](const Workspace& w) { last_output = w.t; });
+    odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                [&](const Workspace& w) { last_output = w.t; });
     FAIL("the run went on with a NaN force");
   } catch (const odyn::SolverError& e) {
     INFO(e.what());
@@ -456,7 +459,7 @@ TEST_CASE("A force far too stiff for the step", "[errors]") {
   ws.v[0] = 1.0;  // moving, so the spring is stretched in the first step
   const odyn::DynamicsSettings settings = short_run();
   try {
-    odyn::simulate(bob.model, ws, settings, [](const Workspace&) {});
+    odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings, [](const Workspace&) {});
     FAIL("the run went on");
   } catch (const odyn::SolverError& e) {
     INFO(e.what());
@@ -476,7 +479,8 @@ TEST_CASE("A force far too stiff for the step: the message names the force", "[e
                                }));
   Workspace ws(bob.model);
   ws.v[0] = 1.0;
-  REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, short_run(), [](const Workspace&) {}),
+  REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, short_run(),
+                                                                     [](const Workspace&) {}),
                          odyn::SolverError, SolverErrorAbout("stiff spring", {"converge"}));
 }
 
@@ -486,28 +490,27 @@ TEST_CASE("Run settings", "[errors]") {
   odyn::DynamicsSettings settings = short_run();
   SECTION("non-positive step") {
     settings.step = 0.0;
-    REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, settings, [](const Workspace&) {}),
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                                       [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("dynamics", {"step"}));
   }
   SECTION("end before start") {
     ws.t = 1.0;
-    REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, settings, [](const Workspace&) {}),
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                                       [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("dynamics", {"t_end"}));
-  }
-  SECTION("unknown integrator") {
-    settings.integrator = "euler";
-    REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, settings, [](const Workspace&) {}),
-                           odyn::ModelError, ModelErrorAbout("dynamics", {"'euler'"}));
   }
   SECTION("rho_inf outside [0, 1]") {
     settings.generalized_alpha.rho_inf = 1.5;
-    REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, settings, [](const Workspace&) {}),
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                                       [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("generalized-alpha", {"rho_inf"}));
   }
   SECTION("rho_inf below 0.5 for HHT") {
     settings.integrator = "hht";
     settings.generalized_alpha.rho_inf = 0.3;
-    REQUIRE_THROWS_MATCHES(odyn::simulate(bob.model, ws, settings, [](const Workspace&) {}),
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                                       [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("hht", {"rho_inf"}));
   }
 }

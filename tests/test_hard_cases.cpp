@@ -71,47 +71,48 @@ BricardRun run_bricard(double step, double t_end) {
   settings.output_interval = 0.01;
   BricardRun run;
   double energy0 = 0.0;
-  const auto summary = odyn::simulate(model, ws, settings, [&](const auto& w) {
-    // Energy and the applied and gyroscopic forces Q, written out from q and v.
-    double energy = 0.0;
-    Eigen::VectorXd force(model.num_velocities());
-    for (int b = 1; b <= model.num_bodies(); ++b) {
-      const auto& body = model.body(odyn::BodyId{b});
-      const auto x = w.q.template segment<3>(7 * (b - 1));
-      const auto xd = w.v.template segment<3>(6 * (b - 1));
-      const Eigen::Vector3d omega = w.v.template segment<3>(6 * (b - 1) + 3);
-      energy += 0.5 * body.mass * xd.squaredNorm() + 0.5 * omega.dot(body.inertia * omega) -
-                body.mass * p.gravity.dot(x);
-      force.segment<3>(6 * (b - 1)) = body.mass * p.gravity;
-      force.segment<3>(6 * (b - 1) + 3) = -omega.cross(body.inertia * omega);
-    }
-    if (w.t == 0.0) energy0 = energy;
-    run.energy_error =
-        std::max(run.energy_error, std::abs(energy - energy0) / (p.mass * 9.81 * p.length));
-    Eigen::VectorXd inertial(model.num_velocities());
-    for (int b = 1; b <= model.num_bodies(); ++b)
-      inertial.segment<6>(6 * (b - 1)) =
-          model.body(odyn::BodyId{b}).mass_block() * w.vdot.template segment<6>(6 * (b - 1));
-    const Eigen::VectorXd constraint_force = force - inertial;  // = Phi_q^T lambda
-    // Rank and null space of Phi_q^T by SVD.
-    const Eigen::MatrixXd jacobian = odyn::detail::dense_jacobian(model, w);
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian.transpose(), Eigen::ComputeFullV);
-    const auto& sigma = svd.singularValues();
-    int rank = 0;
-    for (Eigen::Index i = 0; i < sigma.size(); ++i) rank += sigma[i] > 1e-9 * sigma[0] ? 1 : 0;
-    const int deficiency = static_cast<int>(jacobian.rows()) - rank;
-    run.min_deficiency = std::min(run.min_deficiency, deficiency);
-    run.max_deficiency = std::max(run.max_deficiency, deficiency);
-    const Eigen::MatrixXd null_space = svd.matrixV().rightCols(jacobian.rows() - rank);
-    const double null_part = (null_space.transpose() * w.lambda).norm() / w.lambda.norm();
-    if (w.t == 0.0) run.null_at_start = null_part;
-    run.null_later = std::max(run.null_later, null_part);
-    run.force_mismatch =
-        std::max(run.force_mismatch, (jacobian.transpose() * w.lambda - constraint_force).norm() /
-                                         constraint_force.norm());
-    run.phi = std::max(run.phi, w.phi.cwiseAbs().maxCoeff());
-    run.drop = std::min(run.drop, w.q[2]);
-  });
+  const auto summary =
+      odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const auto& w) {
+        // Energy and the applied and gyroscopic forces Q, written out from q and v.
+        double energy = 0.0;
+        Eigen::VectorXd force(model.num_velocities());
+        for (int b = 1; b <= model.num_bodies(); ++b) {
+          const auto& body = model.body(odyn::BodyId{b});
+          const auto x = w.q.template segment<3>(7 * (b - 1));
+          const auto xd = w.v.template segment<3>(6 * (b - 1));
+          const Eigen::Vector3d omega = w.v.template segment<3>(6 * (b - 1) + 3);
+          energy += 0.5 * body.mass * xd.squaredNorm() + 0.5 * omega.dot(body.inertia * omega) -
+                    body.mass * p.gravity.dot(x);
+          force.segment<3>(6 * (b - 1)) = body.mass * p.gravity;
+          force.segment<3>(6 * (b - 1) + 3) = -omega.cross(body.inertia * omega);
+        }
+        if (w.t == 0.0) energy0 = energy;
+        run.energy_error =
+            std::max(run.energy_error, std::abs(energy - energy0) / (p.mass * 9.81 * p.length));
+        Eigen::VectorXd inertial(model.num_velocities());
+        for (int b = 1; b <= model.num_bodies(); ++b)
+          inertial.segment<6>(6 * (b - 1)) =
+              model.body(odyn::BodyId{b}).mass_block() * w.vdot.template segment<6>(6 * (b - 1));
+        const Eigen::VectorXd constraint_force = force - inertial;  // = Phi_q^T lambda
+        // Rank and null space of Phi_q^T by SVD.
+        const Eigen::MatrixXd jacobian = odyn::detail::dense_jacobian(model, w);
+        const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian.transpose(), Eigen::ComputeFullV);
+        const auto& sigma = svd.singularValues();
+        int rank = 0;
+        for (Eigen::Index i = 0; i < sigma.size(); ++i) rank += sigma[i] > 1e-9 * sigma[0] ? 1 : 0;
+        const int deficiency = static_cast<int>(jacobian.rows()) - rank;
+        run.min_deficiency = std::min(run.min_deficiency, deficiency);
+        run.max_deficiency = std::max(run.max_deficiency, deficiency);
+        const Eigen::MatrixXd null_space = svd.matrixV().rightCols(jacobian.rows() - rank);
+        const double null_part = (null_space.transpose() * w.lambda).norm() / w.lambda.norm();
+        if (w.t == 0.0) run.null_at_start = null_part;
+        run.null_later = std::max(run.null_later, null_part);
+        run.force_mismatch = std::max(
+            run.force_mismatch,
+            (jacobian.transpose() * w.lambda - constraint_force).norm() / constraint_force.norm());
+        run.phi = std::max(run.phi, w.phi.cwiseAbs().maxCoeff());
+        run.drop = std::min(run.drop, w.q[2]);
+      });
   run.reported = summary.redundant_equations.size();
   run.steps = summary.statistics.steps;
   return run;
@@ -173,18 +174,19 @@ TEST_CASE("Parallelogram four-bar driven through its change points stays on its 
   Largest branch, coupler, crank, phi;
   int change_points = 0;
   double previous_turns = 0.0;
-  const auto summary = odyn::simulate(l.model, ws, settings, [&](const auto& w) {
-    const double crank_angle = w.q[3 * (l.crank.index - 1) + 2];
-    const double coupler_angle = w.q[3 * (l.coupler.index - 1) + 2];
-    const double rocker_angle = w.q[3 * (l.rocker.index - 1) + 2];
-    crank.add(crank_angle - (p.crank_angle + p.speed * w.t));
-    branch.add(rocker_angle - crank_angle);
-    coupler.add(coupler_angle);
-    phi.add(w.phi.cwiseAbs().maxCoeff());
-    const double turns = std::floor(crank_angle / pi + 1e-9);
-    if (w.t > 0.0 && turns > previous_turns) ++change_points;
-    previous_turns = turns;
-  });
+  const auto summary =
+      odyn::simulate_with<odyn::GeneralizedAlpha>(l.model, ws, settings, [&](const auto& w) {
+        const double crank_angle = w.q[3 * (l.crank.index - 1) + 2];
+        const double coupler_angle = w.q[3 * (l.coupler.index - 1) + 2];
+        const double rocker_angle = w.q[3 * (l.rocker.index - 1) + 2];
+        crank.add(crank_angle - (p.crank_angle + p.speed * w.t));
+        branch.add(rocker_angle - crank_angle);
+        coupler.add(coupler_angle);
+        phi.add(w.phi.cwiseAbs().maxCoeff());
+        const double turns = std::floor(crank_angle / pi + 1e-9);
+        if (w.t > 0.0 && turns > previous_turns) ++change_points;
+        previous_turns = turns;
+      });
   INFO("rocker - crank angle " << branch.value << " rad, coupler angle " << coupler.value
                                << " rad, crank " << crank.value << " rad, |Phi| " << phi.value
                                << ", change points " << change_points << ", Newton iterations "
@@ -225,7 +227,8 @@ TEST_CASE("A rocker driven through a full turn locks at its dead point: a clear 
   settings.t_end = 2.0;
   double last_output = -1.0;
   try {
-    odyn::simulate(l.model, ws, settings, [&](const auto& w) { last_output = w.t; });
+    odyn::simulate_with<odyn::GeneralizedAlpha>(l.model, ws, settings,
+                                                [&](const auto& w) { last_output = w.t; });
     FAIL("the driver turned the rocker past its dead point");
   } catch (const odyn::SolverError& e) {
     const std::string message = e.what();
@@ -313,7 +316,7 @@ TopRun run_heavy_top(double step, double t_end, const Eigen::Quaterniond& refere
   const Eigen::Matrix3d j_centre = p.inertia.asDiagonal();
   TopRun run;
   double energy0 = 0.0, lz0 = 0.0, l0 = 0.0;
-  odyn::simulate(top.model, ws, settings, [&](const auto& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(top.model, ws, settings, [&](const auto& w) {
     const Eigen::Vector3d x = w.q.template head<3>(), xd = w.v.template head<3>();
     const Eigen::Vector3d omega = w.v.template segment<3>(3);
     const Eigen::Quaterniond q(w.q[3], w.q[4], w.q[5], w.q[6]);
@@ -414,7 +417,7 @@ TEST_CASE("Stiff chain: stable far beyond the explicit limit, fast mode damped b
     settings.generalized_alpha.rho_inf = rho;
     std::vector<double> amplitude;  // of the fast mode, per step
     Largest slow_error, fast_displacement;
-    odyn::simulate(chain.model, ws, settings, [&](const auto& w) {
+    odyn::simulate_with<odyn::GeneralizedAlpha>(chain.model, ws, settings, [&](const auto& w) {
       const Eigen::Vector2d u(w.q[0] - p.spacing, w.q[3] - 2.0 * p.spacing);
       const Eigen::Vector2d v(w.v[0], w.v[3]);
       const double eta = fast.dot(p.mass * u), eta_dot = fast.dot(p.mass * v);
@@ -456,27 +459,28 @@ TEST_CASE("Double pendulum over 1000 s: energy and constraints do not drift", "[
   double energy0 = 0.0, first_mean = 0.0, last_mean = 0.0;
   int first_count = 0, last_count = 0;
   Largest energy, phi, velocity, gap;
-  const auto summary = odyn::simulate(d.model, ws, settings, [&](const auto& w) {
-    // Energy written out from q and v: bars' kinetic energy and height of their centres.
-    double e = 0.0;
-    for (int b = 0; b < 2; ++b)
-      e += 0.5 * p.mass * w.v.template segment<2>(3 * b).squaredNorm() +
-           0.5 * (p.mass * p.length * p.length / 12.0) * w.v[3 * b + 2] * w.v[3 * b + 2] +
-           p.mass * p.g * w.q[3 * b + 1];
-    if (w.t == 0.0) energy0 = e;
-    energy.add((e - energy0) / scale);
-    if (w.t <= 100.0) first_mean += (e - energy0) / scale, ++first_count;
-    if (w.t >= 900.0) last_mean += (e - energy0) / scale, ++last_count;
-    const auto [phi_norm, velocity_norm] = odyn::constraint_residuals(d.model, w);
-    phi.add(phi_norm);
-    velocity.add(velocity_norm);
-    // The pins from q: the upper bar's top at the origin, its bottom on the lower bar's top.
-    const Eigen::Vector2d e1(std::cos(w.q[2]), std::sin(w.q[2]));
-    const Eigen::Vector2d e2(std::cos(w.q[5]), std::sin(w.q[5]));
-    const Eigen::Vector2d x1 = w.q.template segment<2>(0), x2 = w.q.template segment<2>(3);
-    gap.add(std::max((x1 - 0.5 * p.length * e1).norm(),
-                     (x1 + 0.5 * p.length * e1 - x2 + 0.5 * p.length * e2).norm()));
-  });
+  const auto summary =
+      odyn::simulate_with<odyn::GeneralizedAlpha>(d.model, ws, settings, [&](const auto& w) {
+        // Energy written out from q and v: bars' kinetic energy and height of their centres.
+        double e = 0.0;
+        for (int b = 0; b < 2; ++b)
+          e += 0.5 * p.mass * w.v.template segment<2>(3 * b).squaredNorm() +
+               0.5 * (p.mass * p.length * p.length / 12.0) * w.v[3 * b + 2] * w.v[3 * b + 2] +
+               p.mass * p.g * w.q[3 * b + 1];
+        if (w.t == 0.0) energy0 = e;
+        energy.add((e - energy0) / scale);
+        if (w.t <= 100.0) first_mean += (e - energy0) / scale, ++first_count;
+        if (w.t >= 900.0) last_mean += (e - energy0) / scale, ++last_count;
+        const auto [phi_norm, velocity_norm] = odyn::constraint_residuals(d.model, w);
+        phi.add(phi_norm);
+        velocity.add(velocity_norm);
+        // The pins from q: the upper bar's top at the origin, its bottom on the lower bar's top.
+        const Eigen::Vector2d e1(std::cos(w.q[2]), std::sin(w.q[2]));
+        const Eigen::Vector2d e2(std::cos(w.q[5]), std::sin(w.q[5]));
+        const Eigen::Vector2d x1 = w.q.template segment<2>(0), x2 = w.q.template segment<2>(3);
+        gap.add(std::max((x1 - 0.5 * p.length * e1).norm(),
+                         (x1 + 0.5 * p.length * e1 - x2 + 0.5 * p.length * e2).norm()));
+      });
   first_mean /= first_count;
   last_mean /= last_count;
   INFO("1000 s at h = " << settings.step << " (" << summary.statistics.steps << " steps, "

@@ -111,7 +111,7 @@ TEST_CASE("Physical pendulum: small-amplitude period and energy", "[pendulums]")
 
   ZeroCrossings crossings;
   double energy0 = 0.0, max_energy_change = 0.0, amplitude = 0.0, max_gap = 0.0;
-  odyn::simulate(model, ws, settings, [&](const Workspace& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const Workspace& w) {
     const BodyState s = state_of(w, body);
     crossings.add(w.t, s.x.x());
     amplitude = std::max(amplitude, std::abs(s.x.x()));
@@ -187,7 +187,7 @@ DoublePendulumRun run_double_pendulum(double step) {
   settings.t_end = 2.0;
   DoublePendulumRun run;
   double energy0 = 0.0;
-  odyn::simulate(model, ws, settings, [&](const Workspace& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const Workspace& w) {
     const double energy = mechanical_energy(model, w);
     if (w.t == 0.0) energy0 = energy;
     run.energy_error = std::max(run.energy_error, std::abs(energy - energy0) / (m * g * l));
@@ -257,7 +257,7 @@ FreeBodyRun run_free_body(double spin, double delta, double step, double t_end) 
   ZeroCrossings crossings;
   Vector3d momentum0 = Vector3d::Zero();
   double energy0 = 0.0;
-  odyn::simulate(model, ws, settings, [&](const Workspace& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const Workspace& w) {
     const BodyState s = state_of(w, body);
     const Vector3d momentum = s.rotation * inertia * s.omega;  // spatial angular momentum
     const double energy = 0.5 * s.omega.dot(inertia * s.omega);
@@ -323,7 +323,7 @@ TEST_CASE("Torque-free body without any joint in the model", "[pendulums]") {
   odyn::DynamicsSettings settings;
   settings.step = 1e-3;
   settings.t_end = 0.01;
-  odyn::simulate(model, ws, settings, [](const Workspace&) {});
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [](const Workspace&) {});
   const Vector3d expected = Vector3d(0.0, 20.0, 0.03);  // R J omega, conserved
   const BodyState s = state_of(ws, BodyId{1});
   CHECK((s.rotation * brick.inertia * s.omega - expected).norm() < 1e-6);
@@ -361,7 +361,7 @@ TEST_CASE("Heavy symmetric top: steady precession", "[pendulums]") {
   settings.output_interval = 0.01;
   settings.t_end = 1.0;  // ~0.63 of a precession turn, 1000 steps
   double tilt_error = 0.0, spin_error = 0.0, azimuth = 0.0, previous = 0.0;
-  odyn::simulate(model, ws, settings, [&](const Workspace& w) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const Workspace& w) {
     const BodyState s = state_of(w, body);
     const Vector3d e3 = s.rotation.col(2);
     tilt_error = std::max(tilt_error, std::abs(std::acos(e3.z()) - theta));

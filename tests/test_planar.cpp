@@ -320,7 +320,7 @@ TEST_CASE("planar compound pendulum: large-amplitude period", "[planar][dynamics
   // Turning points: the angular velocity changes sign; interpolate linearly between samples.
   std::vector<double> turns;
   double t_prev = 0.0, w_prev = 0.0;
-  odyn::simulate(model, ws, settings, [&](const Workspace& state) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const Workspace& state) {
     const double w = state.v[2];
     if (state.t > 0.0 && w_prev != 0.0 && (w > 0.0) != (w_prev > 0.0))
       turns.push_back(t_prev + (state.t - t_prev) * w_prev / (w_prev - w));
@@ -370,7 +370,7 @@ TEST_CASE("planar reactions: hand-solved statics and a driven slider", "[planar]
     settings.step = 1e-3;
     settings.t_end = 0.5;
     settings.output_interval = 0.5;
-    odyn::simulate(model, ws, settings, [](const Workspace&) {});
+    odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [](const Workspace&) {});
     CHECK(ws.q[1] == Approx(a / 2 * 0.25).epsilon(1e-10));
     CHECK(ws.v[1] == Approx(a * 0.5).epsilon(1e-10));
     const auto force = odyn::reaction(model, ws, lift, odyn::Side::b).force;
@@ -402,7 +402,7 @@ TEST_CASE("four-bar linkage: closed-form position analysis and the motor's power
   settings.generalized_alpha.rho_inf = 0.5;
   std::vector<double> times, energy, power;
   double angle_error = 0.0;
-  odyn::simulate(l.model, ws, settings, [&](const auto& s) {
+  odyn::simulate_with<odyn::GeneralizedAlpha>(l.model, ws, settings, [&](const auto& s) {
     const double t2 = s.frames[l.crank.index].angle;
     CHECK(t2 == Approx(p.speed * s.t).margin(1e-12));
     double t4 = rocker_angle(t2);

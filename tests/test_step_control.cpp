@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "engine_model.hpp"
@@ -85,6 +86,24 @@ TEST_CASE("Outputs land on the output times; dense output is as accurate as the 
   CHECK(run.z_error < 2e-9);
   CHECK(run.theta_error < 1e-8);
   CHECK(run.summary.max_position_residual < 1e-11);
+}
+
+// Selection by name is the one path that instantiates every integrator for a model, so it is
+// checked here, on the model whose runs already go through it.
+TEST_CASE("An unknown integrator name is refused, with the known names", "[errors]") {
+  auto e = engine::planar::build();
+  odyn::Workspace<engine::planar::Model> ws(e.model);
+  odyn::DynamicsSettings settings;
+  settings.integrator = "euler";
+  try {
+    odyn::simulate(e.model, ws, settings, [](const auto&) {});
+    FAIL("the run started");
+  } catch (const odyn::ModelError& error) {
+    const std::string message = error.what();
+    CHECK_THAT(message, Catch::Contains("dynamics") && Catch::Contains("'euler'"));
+    for (const auto& [name, what] : odyn::integrator_names())
+      CHECK_THAT(message, Catch::Contains(name));
+  }
 }
 
 }  // namespace test_step_control

@@ -23,8 +23,10 @@ struct Run {
   odyn::RunSummary summary;
 };
 
-/// Runs the top for 1 s with outputs every 0.01 s.
-inline Run run(odyn::DynamicsSettings settings) {
+/// Runs the top for 1 s with outputs every 0.01 s, with the integrator named at compile time
+/// (only that one is instantiated).
+template <template <class> class Integrator>
+Run run(odyn::DynamicsSettings settings) {
   namespace sp = odyn::spatial;
   using Eigen::Vector3d;
   const double g = 9.81, m = 1.0, l = 0.05, a = 0.002, c = 0.0035, theta = std::numbers::pi / 6,
@@ -53,17 +55,18 @@ inline Run run(odyn::DynamicsSettings settings) {
   settings.t_end = 1.0;
   settings.output_interval = 0.01;
   double previous = 0.0;
-  out.summary = odyn::simulate(model, ws, settings, [&](const odyn::Workspace<Model>& w) {
-    const Eigen::Matrix3d rotation = w.frames[body.index].rotation;
-    const Vector3d e3 = rotation.col(2);
-    out.tilt_error = std::max(out.tilt_error, std::abs(std::acos(e3.z()) - theta));
-    out.spin_error =
-        std::max(out.spin_error, std::abs(w.frames[body.index].angular_velocity.z() - w3));
-    out.unit_error = std::max(out.unit_error, std::abs(w.q.segment<4>(3).norm() - 1.0));
-    const double angle = std::atan2(e3.y(), e3.x());
-    if (w.t > 0.0) out.azimuth += std::remainder(angle - previous, 2.0 * std::numbers::pi);
-    previous = angle;
-  });
+  out.summary =
+      odyn::simulate_with<Integrator>(model, ws, settings, [&](const odyn::Workspace<Model>& w) {
+        const Eigen::Matrix3d rotation = w.frames[body.index].rotation;
+        const Vector3d e3 = rotation.col(2);
+        out.tilt_error = std::max(out.tilt_error, std::abs(std::acos(e3.z()) - theta));
+        out.spin_error =
+            std::max(out.spin_error, std::abs(w.frames[body.index].angular_velocity.z() - w3));
+        out.unit_error = std::max(out.unit_error, std::abs(w.q.segment<4>(3).norm() - 1.0));
+        const double angle = std::atan2(e3.y(), e3.x());
+        if (w.t > 0.0) out.azimuth += std::remainder(angle - previous, 2.0 * std::numbers::pi);
+        previous = angle;
+      });
   return out;
 }
 
