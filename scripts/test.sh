@@ -39,9 +39,11 @@ finish() {
 }
 
 section "Python package (pip install .), built beside the C++ builds"
+# At a lower priority: the sanitizer build is the longest chain (its test run waits for it), so
+# it gets the cores first and the package fills the gaps.
 mkdir -p build
 python_log=build/python-package.log
-CMAKE_BUILD_PARALLEL_LEVEL=$jobs bash scripts/setup.sh >"$python_log" 2>&1 &
+CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh >"$python_log" 2>&1 &
 python_pid=$!
 
 section "ASan + UBSan build of the tests (build-asan/)"

@@ -21,7 +21,7 @@ Vector2d vec2(const py::dict& d, const char* key) {
 
 /// A planar joint frame {point, axis}; an axis left out (None) is the zero vector, which the
 /// library reads as "parallel to the other body's axis at the initial pose".
-pl::JointFrame joint_frame(const py::dict& d, const char* key) {
+pl::JointFrame planar_joint_frame(const py::dict& d, const char* key) {
   pl::JointFrame out;
   if (!d.contains(key) || d[key].is_none()) return out;
   const py::dict frame = d[key].cast<py::dict>();
@@ -78,8 +78,8 @@ void add_planar_element(PlanarBox& box, const std::string& type, const py::dict&
   const std::string what = type + " '" + name + "'";
   auto body = [&](const char* key) { return model.body(text(d, key)); };
   auto pair = [&]<class Joint>(std::type_identity<Joint>) {
-    model.add(Joint(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                    joint_frame(d, "on_b")));
+    model.add(Joint(name, body("body_a"), planar_joint_frame(d, "on_a"), body("body_b"),
+                    planar_joint_frame(d, "on_b")));
   };
   if (type == "revolute") return pair(std::type_identity<pl::Revolute>{});
   if (type == "translational") return pair(std::type_identity<pl::Translational>{});
@@ -88,13 +88,13 @@ void add_planar_element(PlanarBox& box, const std::string& type, const py::dict&
     return void(model.add(pl::Distance(name, body("body_a"), vec2(d, "point_a"), body("body_b"),
                                        vec2(d, "point_b"), number(d, "length"))));
   if (type == "revolute_driver")
-    return void(
-        model.add(pl::RevoluteDriver(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                                     joint_frame(d, "on_b"), motion(d, what))));
+    return void(model.add(pl::RevoluteDriver(name, body("body_a"), planar_joint_frame(d, "on_a"),
+                                             body("body_b"), planar_joint_frame(d, "on_b"),
+                                             motion(d, what))));
   if (type == "translational_driver")
-    return void(model.add(pl::TranslationalDriver(name, body("body_a"), joint_frame(d, "on_a"),
-                                                  body("body_b"), joint_frame(d, "on_b"),
-                                                  motion(d, what))));
+    return void(model.add(pl::TranslationalDriver(name, body("body_a"),
+                                                  planar_joint_frame(d, "on_a"), body("body_b"),
+                                                  planar_joint_frame(d, "on_b"), motion(d, what))));
   if (type == "gravity") return void(model.add(pl::Gravity(name, vec2(d, "acceleration"))));
   if (type == "point_force") {
     if (is_callable(d, "force"))
@@ -122,8 +122,8 @@ void add_planar_element(PlanarBox& box, const std::string& type, const py::dict&
         number(d, "stiffness"), number(d, "damping"), number(d, "free_angle"), {}};
     if (is_callable(d, "actuator"))
       p.actuator = scalar_function3(d["actuator"], what + " actuator");
-    return void(model.add(pl::Rsda(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                                   joint_frame(d, "on_b"), p)));
+    return void(model.add(pl::Rsda(name, body("body_a"), planar_joint_frame(d, "on_a"),
+                                   body("body_b"), planar_joint_frame(d, "on_b"), p)));
   }
   if (type == "engine_gas_force") {
     engine::Parameters p;

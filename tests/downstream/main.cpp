@@ -35,7 +35,8 @@ int main() {
 
   odyn::Workspace<Model> ws(model);
   odyn::DynamicsSettings settings{.step = 1e-3, .t_end = 2.0, .output_interval = 0.5};
-  odyn::simulate(model, ws, settings, [&](const auto& state) {
+  // The integrator, chosen at compile time (odyn::simulate takes its name at run time instead).
+  odyn::simulate_with<odyn::GeneralizedAlpha>(model, ws, settings, [&](const auto& state) {
     const auto reaction = odyn::reaction(model, state, hinge);
     std::printf(
         "t = %.1f s  angle = %+.4f rad  hinge force = (%+.3f, %+.3f) N\n", state.t,
