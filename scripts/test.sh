@@ -26,8 +26,9 @@ bash scripts/setup.sh --no-package
 # Each test compiles once: the Catch2 suite in the sanitizer build, the examples (the C++ twins
 # of the Python tests) and the installed package's consumer in Release, and the Python package.
 # Template instantiation makes each translation unit cost tens of seconds of CPU, so the builds
-# run side by side and keep both cores busy: the Python package beside the sanitizer build, the
-# test run and the one-file downstream build beside the Release build.
+# run side by side. The longest chain is the sanitizer build (one unity unit: its files share
+# their models and integrators) and its test run; the rest builds beside it at a lower priority,
+# so that it fills the other core without slowing that chain.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -38,13 +39,28 @@ finish() {
   if ((rc != 0)); then echo "test.sh: $3 failed (exit $rc)" >&2; exit "$rc"; fi
 }
 
-section "Python package (pip install .), built beside the C++ builds"
-# At a lower priority: the sanitizer build is the longest chain (its test run waits for it), so
-# it gets the cores first and the package fills the gaps.
+section "Beside the sanitizer build: the Python package, the Release examples, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
 CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh >"$python_log" 2>&1 &
 python_pid=$!
+configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
+  -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
+# The library is header-only: the configured tree installs before anything is built.
+rm -rf build/install build/downstream
+cmake --install build --prefix build/install >/dev/null
+release_log=build/release.log
+(
+  nice -n 10 cmake --build build -j "$jobs" --target engine slider_crank_planar four_bar andrews
+  launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
+    -DCMAKE_PREFIX_PATH="$root/build/install"
+  nice -n 10 cmake --build build/downstream -j 1
+  echo "Install + downstream find_package(odyn):"
+  ./build/downstream/odyn_downstream
+) >"$release_log" 2>&1 &
+release_pid=$!
 
 section "ASan + UBSan build of the tests (build-asan/)"
 # -Og -g1 (line tables: enough for sanitizer stack traces) compiles twice as fast as -O1 -g here.
@@ -52,36 +68,15 @@ configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" 
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 
-section "Release build of the examples (build/); the ASan + UBSan tests and downstream beside it"
-configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
-  -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
-asan_log=build-asan/odyn_tests.log
+section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
 (
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
   ctest --test-dir build-asan --output-on-failure
-) >"$asan_log" 2>&1 &
-asan_pid=$!
-# The library is header-only: the configured tree installs before anything is built.
-rm -rf build/install build/downstream
-cmake --install build --prefix build/install >/dev/null
-downstream_log=build/downstream.log
-(
-  launcher=()
-  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
-    -DCMAKE_PREFIX_PATH="$root/build/install"
-  cmake --build build/downstream -j 1
-  ./build/downstream/odyn_downstream
-) >"$downstream_log" 2>&1 &
-downstream_pid=$!
-cmake --build build -j "$jobs" --target engine slider_crank_planar four_bar andrews
+)
 
-section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
-finish "$asan_pid" "$asan_log" "the ASan + UBSan tests"
-
-section "Install + downstream find_package(odyn)"
-finish "$downstream_pid" "$downstream_log" "the downstream build"
+section "Release examples, install + downstream find_package(odyn)"
+finish "$release_pid" "$release_log" "the Release examples or the downstream build"
 
 section "Python package"
 finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
