@@ -18,8 +18,9 @@ std::atomic<bool> counting{false};
 
 #ifdef __SANITIZE_ADDRESS__
 // From <sanitizer/allocator_interface.h>, which GCC does not ship; libasan defines it.
-extern "C" int __sanitizer_install_malloc_and_free_hooks(
-    void (*malloc_hook)(const volatile void*, std::size_t), void (*free_hook)(const volatile void*));
+using MallocHook = void (*)(const volatile void*, std::size_t);
+using FreeHook = void (*)(const volatile void*);
+extern "C" int __sanitizer_install_malloc_and_free_hooks(MallocHook, FreeHook);
 
 namespace test_allocation {
 void on_malloc(const volatile void*, std::size_t) {
