@@ -1,16 +1,123 @@
 // The linear algebra under every analysis: the envelope Cholesky of small Schur complements
-// against Eigen's dense LLT, and both saddle-point solvers against the system they solve,
-// checked through its residual [M Phi_q^T; Phi_q 0] [x; y] - [f; g] with the model's own
-// products (mass_times, Phi_q x, Phi_q^T y), which share no code with the factorizations.
+// against Eigen's dense LLT; the pivoted LU and the rank-revealing QR against systems built with
+// a known solution, rank and null space; the closed-form principal moments against a rotated
+// diagonal tensor; and both saddle-point solvers against the system they solve, checked through
+// its residual [M Phi_q^T; Phi_q 0] [x; y] - [f; g] with the model's own products (mass_times,
+// Phi_q x, Phi_q^T y), which share no code with the factorizations.
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <vector>
 
 #include "engine_model.hpp"
+#include "odyn/linalg/pivoted_lu.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 #include "odyn/linalg/small_cholesky.hpp"
+#include "odyn/linalg/symmetric_eigenvalues.hpp"
 
 namespace test_linear_solvers {
+
+/// A deterministic dense matrix with entries in [-1, 1] and no structure (the product term
+/// keeps it from being a sum of two separable rank-one terms, as sin(f(i) + g(j)) would be).
+Eigen::MatrixXd scrambled(Eigen::Index rows, Eigen::Index cols, double seed) {
+  Eigen::MatrixXd a(rows, cols);
+  for (Eigen::Index i = 0; i < rows; ++i)
+    for (Eigen::Index j = 0; j < cols; ++j) {
+      const auto x = static_cast<double>(i), y = static_cast<double>(j);
+      a(i, j) = std::sin(seed + 12.9898 * x + 78.233 * y + 3.7 * x * y * (1.0 + y));
+    }
+  return a;
+}
+
+TEST_CASE("Pivoted LU recovers a known solution and flags a singular matrix", "[linalg]") {
+  for (const Eigen::Index n : {1, 5, 35}) {
+    INFO("n = " << n);
+    const Eigen::MatrixXd a = scrambled(n, n, 0.3);
+    const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+    const Eigen::VectorXd b = a * expected;
+    odyn::PivotedLu lu;
+    lu.resize(n);
+    lu.compute(a);
+    REQUIRE(lu.smallest_pivot() > 1e-6 * lu.largest_entry());
+    Eigen::VectorXd x = b;
+    lu.solve_in_place(x);
+    // Backward stable: a residual at rounding level; the forward error also depends on the
+    // matrix's condition (about 1e4 for n = 35).
+    CHECK((a * x - b).norm() <= 1e-14 * a.norm() * x.norm());
+    CHECK((x - expected).norm() <= 1e-9 * expected.norm());
+  }
+  // Column 3 = column 0 + column 1: a pivot vanishes to rounding.
+  Eigen::MatrixXd singular = scrambled(6, 6, 1.1);
+  singular.col(3) = singular.col(0) + singular.col(1);
+  odyn::PivotedLu lu;
+  lu.compute(singular);
+  CHECK(lu.smallest_pivot() <= 1e-14 * lu.largest_entry());
+  // The fixed-size elimination of the BDF position update.
+  const Eigen::Matrix<double, 7, 7> small = scrambled(7, 7, 2.0);
+  const Eigen::Matrix<double, 7, 1> known = Eigen::Matrix<double, 7, 1>::LinSpaced(-3.0, 1.0);
+  const Eigen::Matrix<double, 7, 1> solved = odyn::solve_small<7>(small, small * known);
+  CHECK((solved - known).norm() <= 1e-12 * known.norm());
+}
+
+TEST_CASE("Rank-revealing QR: rank, and minimum-norm least-squares solutions", "[linalg]") {
+  // A = B C of rank 3: null(A) = null(C) and range(A) = range(B). The minimum-norm
+  // least-squares x satisfies the normal equations A^T (A x - b) = 0 and lies in range(C^T);
+  // both are checked with products only.
+  for (const auto& [rows, cols] : {std::pair{7, 5}, std::pair{5, 7}, std::pair{4, 4}}) {
+    INFO(rows << " x " << cols);
+    const Eigen::MatrixXd b_factor = scrambled(rows, 3, 0.5), c_factor = scrambled(3, cols, 1.5);
+    const Eigen::MatrixXd a = b_factor * c_factor;
+    const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(rows, 1.0, -2.0);  // inconsistent
+    const odyn::RankRevealingQr qr(a, odyn::rank_tolerance);
+    CHECK(qr.rank() == 3);
+    const Eigen::VectorXd x = qr.solve(rhs);
+    CHECK((a.transpose() * (a * x - rhs)).norm() <= 1e-12 * a.norm() * a.norm() * rhs.norm());
+    const Eigen::Matrix3d gram = c_factor * c_factor.transpose();
+    const Eigen::Vector3d w = gram.inverse() * (c_factor * x);
+    CHECK((c_factor.transpose() * w - x).norm() <= 1e-12 * x.norm());
+    // The columns it lists after the rank depend on the ones before them.
+    const auto& order = qr.column_order();
+    Eigen::MatrixXd independent(rows, 3);
+    for (int k = 0; k < 3; ++k) independent.col(k) = a.col(order[static_cast<std::size_t>(k)]);
+    const Eigen::Matrix3d normal = independent.transpose() * independent;
+    for (Eigen::Index k = 3; k < cols; ++k) {
+      const Eigen::VectorXd column = a.col(order[static_cast<std::size_t>(k)]);
+      const Eigen::Vector3d fit = normal.inverse() * (independent.transpose() * column);
+      CHECK((independent * fit - column).norm() <= 1e-10 * column.norm());
+    }
+  }
+  SECTION("full rank: the exact solution") {
+    const Eigen::MatrixXd a = scrambled(6, 6, 0.9);
+    const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(6, 2.0, -1.0);
+    const odyn::RankRevealingQr qr(a, odyn::rank_tolerance);
+    CHECK(qr.rank() == 6);
+    CHECK((qr.solve(a * expected) - expected).norm() <= 1e-12 * expected.norm());
+  }
+  SECTION("zero matrix: rank 0 and x = 0") {
+    const odyn::RankRevealingQr qr(Eigen::MatrixXd::Zero(3, 4), odyn::rank_tolerance);
+    CHECK(qr.rank() == 0);
+    CHECK(qr.solve(Eigen::VectorXd::Ones(3)).isZero(0.0));
+  }
+}
+
+TEST_CASE("Principal moments in closed form equal those of a rotated diagonal tensor", "[linalg]") {
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  // A disc's J J 2J, nearly equal moments, a thin rod's, an indefinite tensor.
+  for (const Eigen::Vector3d& moments :
+       {Eigen::Vector3d(0.5, 2.0, 2.25), Eigen::Vector3d(3.0, 3.0, 3.0),
+        Eigen::Vector3d(1.0, 1.0, 2.0), Eigen::Vector3d(1.0, 1.0 + 1e-9, 1.5),
+        Eigen::Vector3d(1e-3, 1.0, 1.0), Eigen::Vector3d(-1.0, 0.25, 4.0)}) {
+    INFO("moments " << moments.transpose());
+    const Eigen::Matrix3d tensor = rotation * moments.asDiagonal() * rotation.transpose();
+    const Eigen::Vector3d computed = odyn::symmetric_eigenvalues(tensor);
+    CHECK((computed - moments).cwiseAbs().maxCoeff() <= 1e-14 * moments.cwiseAbs().maxCoeff());
+    CHECK((odyn::symmetric_eigenvalues(Eigen::Matrix3d(moments.reverse().asDiagonal())) - moments)
+              .isZero(0.0));
+  }
+}
 
 /// A random symmetric positive definite n x n matrix whose column j has no entry below row
 /// end[j] - 1 (a band of half-width `band` when end is built from it).

@@ -11,14 +11,15 @@
 // and redundant_equations(model, ws) says which equations repeat others.
 
 #include <Eigen/Core>
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 
 namespace odyn {
 
@@ -70,10 +71,9 @@ RedundantEquation locate_row(const Model& model, int row) {
 inline std::vector<int> dependent_rows(const Eigen::MatrixXd& jacobian) {
   std::vector<int> rows;
   if (jacobian.rows() == 0) return rows;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(jacobian.transpose());
-  qr.setThreshold(1e-10);
+  const RankRevealingQr qr(jacobian.transpose(), rank_tolerance);
   for (Eigen::Index k = qr.rank(); k < jacobian.rows(); ++k)
-    rows.push_back(static_cast<int>(qr.colsPermutation().indices()[k]));
+    rows.push_back(qr.column_order()[static_cast<std::size_t>(k)]);
   std::sort(rows.begin(), rows.end());
   return rows;
 }
@@ -98,14 +98,8 @@ Eigen::MatrixXd dense_mass(const Model& model) {
 template <class Model>
 std::vector<std::string> redundant_equations(const Model& model, const Eigen::MatrixXd& jacobian) {
   std::vector<std::string> names;
-  if (jacobian.rows() == 0) return names;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(jacobian.transpose());
-  qr.setThreshold(1e-10);
-  const Eigen::Index rank = qr.rank();
-  for (Eigen::Index k = rank; k < jacobian.rows(); ++k) {
-    const int row = qr.colsPermutation().indices()[k];
+  for (const int row : dependent_rows(jacobian))
     names.push_back(model.constraint_name(row) + " (equation " + std::to_string(row) + ")");
-  }
   return names;
 }
 
@@ -120,9 +114,7 @@ inline void solve_saddle_point(const Eigen::MatrixXd& a, const Eigen::MatrixXd& 
   kkt.topRightCorner(n, m) = c.transpose();
   Eigen::VectorXd rhs(n + m);
   rhs << f, g;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(kkt);
-  cod.setThreshold(1e-12);
-  const Eigen::VectorXd solution = cod.solve(rhs);
+  const Eigen::VectorXd solution = RankRevealingQr(kkt, 1e-12).solve(rhs);
   x = solution.head(n);
   y = solution.tail(m);
 }
@@ -155,8 +147,9 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
   int iteration = 0;
   for (; iteration < s.max_iterations && norm > s.tolerance && std::isfinite(norm); ++iteration) {
     const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
-    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(jacobian);
-    const Eigen::VectorXd step = -cod.solve(ws.phi);
+    // Rank to rounding: a step along nearly dependent rows is still a step toward Phi = 0.
+    const double threshold = std::numeric_limits<double>::epsilon() * static_cast<double>(m);
+    const Eigen::VectorXd step = -RankRevealingQr(jacobian, threshold).solve(ws.phi);
     const Eigen::VectorXd start = ws.q;
     // Halve the step until the residual decreases: a damped Newton method.
     double fraction = 1.0;
@@ -210,10 +203,7 @@ AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const Assembly
   Eigen::MatrixXd rows = jacobian;
   Eigen::VectorXd rhs = -ws.phi_t;
   auto rank_of = [](const Eigen::MatrixXd& a) {
-    if (a.rows() == 0) return Eigen::Index{0};
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a.transpose());
-    qr.setThreshold(1e-10);
-    return qr.rank();
+    return a.rows() == 0 ? Eigen::Index{0} : RankRevealingQr(a.transpose(), rank_tolerance).rank();
   };
   Eigen::Index rank = rank_of(rows);
   for (int b = 1; b <= model.num_bodies(); ++b) {

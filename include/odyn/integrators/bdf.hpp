@@ -33,7 +33,6 @@
 // Appl. Math. 12-13 (1985) 77-90.
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -45,6 +44,7 @@
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
 #include "odyn/linalg/minimum_norm.hpp"
+#include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -486,7 +486,7 @@ class Bdf {
         matrix.col(i) -= c_ * (Space::configuration_rate(Configuration::Unit(i), w) - offset);
       const Configuration right = beta_.template segment<nq>(b * nq) + c_ * offset;
       auto q = ws_.q.template segment<nq>(b * nq);
-      q = matrix.partialPivLu().solve(right);
+      q = solve_small<nq>(matrix, right);
       Space::normalize(q);
     }
     ws_.vdot = (ws_.v - beta_.tail(nv_total_)) / c_;

@@ -8,8 +8,9 @@
 // the minimum-norm least-squares solution; it is never used on the fast path.
 
 #include <Eigen/Core>
-#include <Eigen/LU>
-#include <Eigen/QR>
+
+#include "odyn/linalg/pivoted_lu.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 
 namespace odyn {
 
@@ -19,7 +20,7 @@ class DenseLu {
 
   /// Sizes the factorization once, so that later factorizations allocate nothing.
   void analyze_pattern(const Matrix& a) {
-    lu_ = Eigen::PartialPivLU<Matrix>(a.rows());
+    lu_.resize(a.rows());
     rank_revealing_ = false;
   }
 
@@ -28,9 +29,7 @@ class DenseLu {
     rank_revealing_ = false;
     lu_.compute(a);
     // A zero or tiny pivot relative to the largest entry means a singular matrix.
-    const double largest = lu_.matrixLU().cwiseAbs().maxCoeff();
-    const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
-    return smallest_pivot > 1e-13 * largest;
+    return lu_.smallest_pivot() > 1e-13 * lu_.largest_entry();
   }
 
   /// Factorizes a possibly singular matrix by a complete orthogonal decomposition (rank decided
@@ -38,24 +37,25 @@ class DenseLu {
   /// give the minimum-norm least-squares solution, until the next factorize.
   int factorize_rank_revealing(const Matrix& a, double threshold) {
     rank_revealing_ = true;
-    cod_.setThreshold(threshold);
-    cod_.compute(a);
+    cod_.compute(a, threshold);
     return static_cast<int>(a.rows() - cod_.rank());
   }
 
   /// x = A^-1 b (x and b must not alias); the minimum-norm solution after a rank-revealing
   /// factorization.
-  template <class Rhs, class Dst>
-  void solve(const Rhs& b, Dst& x) const {
-    if (rank_revealing_)
-      x.noalias() = cod_.solve(b);
-    else
-      x.noalias() = lu_.solve(b);
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    if (rank_revealing_) {
+      cod_.solve(b, x, work_);
+    } else {
+      x = b;
+      lu_.solve_in_place(x);
+    }
   }
 
  private:
-  Eigen::PartialPivLU<Matrix> lu_;
-  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
+  PivotedLu lu_;
+  RankRevealingQr cod_;
+  Eigen::VectorXd work_;  // scratch for the rank-revealing solve
   bool rank_revealing_ = false;
 };
 

@@ -7,9 +7,9 @@
 // Phi_q^T lambda = (the same constraint forces).
 
 #include <Eigen/Core>
-#include <Eigen/QR>
 
 #include "odyn/analysis/system.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 
 namespace odyn {
 
@@ -23,8 +23,8 @@ void make_multipliers_minimum_norm(const Model& model, Workspace<Model>& ws) {
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(m, n);
   write_jacobian(model, ws, jacobian, 0, 0, false);
   const Eigen::VectorXd forces = jacobian.transpose() * ws.lambda;
-  ws.lambda =
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(jacobian.transpose()).solve(forces);
+  const Eigen::MatrixXd transposed = jacobian.transpose();
+  ws.lambda = RankRevealingQr(transposed, rank_tolerance).solve(forces);
 }
 
 }  // namespace odyn

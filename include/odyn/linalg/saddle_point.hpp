@@ -27,15 +27,13 @@
 // An inconsistent right-hand side (constraints that cannot all hold, or a driver at a dead
 // point) gets the least-squares y: the constraint residual then does not vanish and the
 // caller's convergence test fails, so it never hides.
-// The rank is decided relative to the largest eigenvalue of S (or the largest entry of the
-// dense matrix), with threshold rank_tolerance. A full-rank system keeps the fast path:
+// The rank is decided by a column-pivoted QR of S (or of the dense matrix): a pivot counts if it
+// exceeds rank_tolerance times the first. A full-rank system keeps the fast path:
 // Cholesky of S (the block Schur solver) or LU (the dense one); the rank-revealing
 // factorizations run only when that path finds a singular matrix.
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
-#include <Eigen/QR>
+#include <Eigen/LU>  // inverse() of the small fixed-size body blocks
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -44,6 +42,8 @@
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/linalg/dense_lu.hpp"
+#include "odyn/linalg/pivoted_lu.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 #include "odyn/linalg/small_cholesky.hpp"
 
 namespace odyn {
@@ -54,10 +54,6 @@ struct IterationFactors {
   double stiffness = 0.0;
   double damping = 0.0;
 };
-
-/// Relative size below which an eigenvalue of S (or a pivot of the dense matrix) counts as zero:
-/// the equations it belongs to are redundant.
-inline constexpr double rank_tolerance = 1e-10;
 
 template <class Model>
 class DenseSaddlePoint {
@@ -84,9 +80,7 @@ class DenseSaddlePoint {
     return true;
   }
 
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) const {
-    lu_.solve(rhs, solution);
-  }
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) { lu_.solve(rhs, solution); }
 
   /// Number of dependent rows of the last factorized matrix (0: full rank).
   int rank_deficiency() const { return rank_deficiency_; }
@@ -200,12 +194,12 @@ class BlockSchurSaddlePoint {
         for (const int j : body_rows)
           if (i >= j) envelope_end[j] = std::max<Eigen::Index>(envelope_end[j], i + 1);
     schur_cholesky_.resize(m_, envelope_end);
-    schur_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(m_);
-    // Sized (and its info() defined, which UBSan checks on copies) by a first computation.
-    if (m_ > 0) schur_eigen_.compute(Eigen::MatrixXd::Identity(m_, m_));
-    inverse_eigenvalues_ = Eigen::VectorXd::Zero(m_);
+    schur_lu_.resize(m_);
+    // Sized by a first computation, so that a singular S later allocates nothing.
+    schur_minimum_norm_.compute(Eigen::MatrixXd::Identity(m_, m_), rank_tolerance);
     work_m_ = Eigen::VectorXd::Zero(m_);
-    work_eigen_ = Eigen::VectorXd::Zero(m_);
+    work_y_ = Eigen::VectorXd::Zero(m_);
+    work_qr_ = Eigen::VectorXd::Zero(m_);
     method_ = Method::cholesky;
     rank_deficiency_ = 0;
   }
@@ -273,12 +267,12 @@ class BlockSchurSaddlePoint {
         schur_cholesky_.solve_in_place(solution.tail(m_));
         break;
       case Method::lu:
-        solution.tail(m_).noalias() = schur_lu_.solve(work_m_);
+        solution.tail(m_) = work_m_;
+        schur_lu_.solve_in_place(solution.tail(m_));
         break;
-      case Method::eigen:  // y = V D^+ V^T r
-        work_eigen_.noalias() = schur_eigen_.eigenvectors().transpose() * work_m_;
-        work_eigen_.array() *= inverse_eigenvalues_.array();
-        solution.tail(m_).noalias() = schur_eigen_.eigenvectors() * work_eigen_;
+      case Method::minimum_norm:
+        schur_minimum_norm_.solve(work_m_, work_y_, work_qr_);
+        solution.tail(m_) = work_y_;
         break;
     }
     // x_b = A_b^-1 f_b - (A_b^-1 B_b^T) y_b.
@@ -292,7 +286,7 @@ class BlockSchurSaddlePoint {
   }
 
  private:
-  enum class Method { cholesky, lu, eigen };
+  enum class Method { cholesky, lu, minimum_norm };
 
   /// A_b^-1 for every body. With mass terms only (explicit integrators, projections,
   /// assembly) A is a multiple of the constant mass matrix: its inverses are kept and reused.
@@ -317,7 +311,8 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
-  /// Factorizes the assembled S: Cholesky, else LU, else (singular) its eigen-decomposition.
+  /// Factorizes the assembled S: Cholesky, else LU, else (singular) a complete orthogonal
+  /// decomposition.
   bool factorize_schur() {
     rank_deficiency_ = 0;
     // The fast path: Cholesky on the lower triangle. Its pivots are the diagonal of L squared,
@@ -334,25 +329,16 @@ class BlockSchurSaddlePoint {
     if (!positive_definite) {
       // Not positive definite (A itself is not): LU on the same matrix, if it is regular.
       schur_lu_.compute(schur_);
-      const double largest = schur_lu_.matrixLU().cwiseAbs().maxCoeff();
-      if (schur_lu_.matrixLU().diagonal().cwiseAbs().minCoeff() > rank_tolerance * largest) {
+      if (schur_lu_.smallest_pivot() > rank_tolerance * schur_lu_.largest_entry()) {
         method_ = Method::lu;
         return true;
       }
     }
-    // Singular: redundant (or, at a dead point, locked) constraints. The eigenvalues of the
-    // symmetric S decide its rank; the solve inverts only those above the threshold, which
-    // gives the minimum-norm y.
-    method_ = Method::eigen;
-    schur_eigen_.compute(schur_);
-    if (schur_eigen_.info() != Eigen::Success) return false;
-    const auto& eigenvalues = schur_eigen_.eigenvalues();
-    const double cutoff = rank_tolerance * eigenvalues.cwiseAbs().maxCoeff();
-    for (int i = 0; i < m_; ++i) {
-      const bool kept = std::abs(eigenvalues[i]) > cutoff;
-      inverse_eigenvalues_[i] = kept ? 1.0 / eigenvalues[i] : 0.0;
-      rank_deficiency_ += kept ? 0 : 1;
-    }
+    // Singular: redundant (or, at a dead point, locked) constraints. A rank-revealing QR of S
+    // decides its rank, and its complete orthogonal decomposition gives the minimum-norm y.
+    method_ = Method::minimum_norm;
+    schur_minimum_norm_.compute(schur_, rank_tolerance);
+    rank_deficiency_ = static_cast<int>(m_ - schur_minimum_norm_.rank());
     return true;
   }
 
@@ -372,10 +358,9 @@ class BlockSchurSaddlePoint {
   Columns weighted_;                    // (entries) A_b^-1 B_b^T
   Eigen::MatrixXd schur_;               // (m x m) S = B A^-1 B^T
   SmallCholesky schur_cholesky_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> schur_lu_;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> schur_eigen_;  // singular S only
-  Eigen::VectorXd inverse_eigenvalues_;  // (m) 1/d_i, or 0 for the null space of S
-  Eigen::VectorXd work_m_, work_eigen_;
+  PivotedLu schur_lu_;                  // S not positive definite
+  RankRevealingQr schur_minimum_norm_;  // S singular
+  Eigen::VectorXd work_m_, work_y_, work_qr_;
 };
 
 }  // namespace odyn

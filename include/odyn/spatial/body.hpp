@@ -1,7 +1,6 @@
 #pragma once
 // A spatial rigid body: its inertia and its initial state, as the user describes it.
 
-#include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -9,6 +8,7 @@
 
 #include "odyn/core/errors.hpp"
 #include "odyn/core/spatial.hpp"
+#include "odyn/linalg/symmetric_eigenvalues.hpp"
 
 namespace odyn::spatial {
 
@@ -64,9 +64,7 @@ struct Body {
     if (!inertia.allFinite()) throw ModelError(name, "inertia contains a non-finite value");
     if ((inertia - inertia.transpose()).norm() > 1e-12 * inertia.norm())
       throw ModelError(name, "inertia tensor must be symmetric");
-    const Eigen::Vector3d moments =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia, Eigen::EigenvaluesOnly)
-            .eigenvalues();
+    const Eigen::Vector3d moments = symmetric_eigenvalues(inertia);
     if (!(moments.minCoeff() > 0.0))
       throw ModelError(name, "inertia must be positive definite; principal moments are (" +
                                  to_text(moments.transpose()) + ") kg m^2");
