@@ -60,8 +60,8 @@ class RankRevealingQr {
     rank_ = 0;
     while (rank_ < steps && std::abs(qr_(rank_, rank_)) > threshold * largest_pivot_) ++rank_;
     // [R11 R12] (the first rank rows of R) = [L^T 0] Z^T, from a QR of its transpose.
-    z_.resize(n_, rank_);
-    z_tau_.resize(rank_);
+    z_.resize(n_, steps);  // the first rank columns are used: a change of rank allocates nothing
+    z_tau_.resize(steps);
     for (Eigen::Index i = 0; i < rank_; ++i)
       for (Eigen::Index j = 0; j < n_; ++j) z_(j, i) = j >= i ? qr_(i, j) : 0.0;
     double* z = z_.data();
@@ -146,9 +146,10 @@ class RankRevealingQr {
   Eigen::VectorXd tau_;     // (min(m, n)) Q's reflector factors
   Eigen::VectorXd norms_;   // (n) squared norms of the remaining columns
   std::vector<int> order_;  // (n) the column of A in each position of A P
-  Eigen::MatrixXd z_;       // (n x rank) QR of [R11 R12]^T: L on and above the diagonal, Z's
-                            // reflectors below it
-  Eigen::VectorXd z_tau_;   // (rank) Z's reflector factors
+  Eigen::MatrixXd z_;       // (n x min(m, n)) in its first rank columns, the QR of
+                            // [R11 R12]^T: L on and above the diagonal, Z's reflectors
+                            // below it
+  Eigen::VectorXd z_tau_;   // Z's reflector factors (the first rank entries)
 };
 
 }  // namespace odyn
