@@ -23,8 +23,7 @@ void make_multipliers_minimum_norm(const Model& model, Workspace<Model>& ws) {
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(m, n);
   write_jacobian(model, ws, jacobian, 0, 0, false);
   const Eigen::VectorXd forces = jacobian.transpose() * ws.lambda;
-  const Eigen::MatrixXd transposed = jacobian.transpose();
-  ws.lambda = RankRevealingQr(transposed, rank_tolerance).solve(forces);
+  ws.lambda = RankRevealingQr(jacobian.transpose(), rank_tolerance).solve(forces);
 }
 
 }  // namespace odyn

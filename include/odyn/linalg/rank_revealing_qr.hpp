@@ -1,9 +1,9 @@
 #pragma once
 // Householder QR with column pivoting, A P = Q R, completed to a complete orthogonal
 // decomposition (the first rank rows of R are [L^T 0] Z^T, L upper triangular) for
-// minimum-norm least-squares solutions. It decides the rank
-// of a constraint Jacobian (which equations are redundant) and solves systems that may be
-// singular: assembly's Newton steps, minimum-norm multipliers, a singular Schur complement.
+// minimum-norm least-squares solutions. It decides the rank of a constraint Jacobian (which
+// equations are redundant) and solves systems that may be singular: assembly's Newton steps,
+// minimum-norm multipliers, a singular Schur complement.
 //
 // Written as plain loops over column-major storage rather than with Eigen's
 // CompleteOrthogonalDecomposition: for the matrices here (tens of rows) both run at the same
@@ -37,16 +37,19 @@ class RankRevealingQr {
     const Eigen::Index steps = std::min(m_, n_);
     qr_ = a;
     tau_.resize(steps);
-    norms_.resize(n_);
     order_.resize(static_cast<std::size_t>(n_));
     for (Eigen::Index j = 0; j < n_; ++j) order_[static_cast<std::size_t>(j)] = static_cast<int>(j);
     double* r = qr_.data();
     for (Eigen::Index k = 0; k < steps; ++k) {
       // The remaining column of largest norm (the first of equal ones) becomes column k.
       Eigen::Index pivot = k;
+      double largest = -1.0;
       for (Eigen::Index j = k; j < n_; ++j) {
-        norms_[j] = squared_norm(r + j * m_ + k, m_ - k);
-        if (norms_[j] > norms_[pivot]) pivot = j;
+        const double norm = squared_norm(r + j * m_ + k, m_ - k);
+        if (norm > largest) {
+          largest = norm;
+          pivot = j;
+        }
       }
       if (pivot != k) {
         std::swap_ranges(r + k * m_, r + (k + 1) * m_, r + pivot * m_);
@@ -56,9 +59,9 @@ class RankRevealingQr {
       for (Eigen::Index j = k + 1; j < n_; ++j)
         apply_reflector(r + k * m_ + k, tau_[k], r + j * m_ + k, m_ - k);
     }
-    largest_pivot_ = steps > 0 ? std::abs(qr_(0, 0)) : 0.0;
+    const double cutoff = steps > 0 ? threshold * std::abs(qr_(0, 0)) : 0.0;
     rank_ = 0;
-    while (rank_ < steps && std::abs(qr_(rank_, rank_)) > threshold * largest_pivot_) ++rank_;
+    while (rank_ < steps && std::abs(qr_(rank_, rank_)) > cutoff) ++rank_;
     // [R11 R12] (the first rank rows of R) = [L^T 0] Z^T, from a QR of its transpose.
     z_.resize(n_, steps);  // the first rank columns are used: a change of rank allocates nothing
     z_tau_.resize(steps);
@@ -98,7 +101,6 @@ class RankRevealingQr {
     for (Eigen::Index k = rank_ - 1; k >= 0; --k)
       apply_reflector(z + k * n_ + k, z_tau_[k], x.data() + k, n_ - k);
     // x = P z: entry k of z belongs to column order_[k] of A.
-    work.resize(n_);
     work = x;
     for (Eigen::Index k = 0; k < n_; ++k) x[order_[static_cast<std::size_t>(k)]] = work[k];
   }
@@ -141,10 +143,8 @@ class RankRevealingQr {
   }
 
   Eigen::Index m_ = 0, n_ = 0, rank_ = 0;
-  double largest_pivot_ = 0.0;
   Eigen::MatrixXd qr_;      // (m x n) R on and above the diagonal, Q's reflectors below it
   Eigen::VectorXd tau_;     // (min(m, n)) Q's reflector factors
-  Eigen::VectorXd norms_;   // (n) squared norms of the remaining columns
   std::vector<int> order_;  // (n) the column of A in each position of A P
   Eigen::MatrixXd z_;       // (n x min(m, n)) in its first rank columns, the QR of
                             // [R11 R12]^T: L on and above the diagonal, Z's reflectors
