@@ -298,6 +298,7 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
                         detail::step_control(s));
 
   auto record = [&] {
+    if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
     const auto [phi_norm, phid_norm] = constraint_residuals(model, ws);
     summary.max_position_residual = std::max(summary.max_position_residual, phi_norm);
     summary.max_velocity_residual = std::max(summary.max_velocity_residual, phid_norm);

@@ -5,8 +5,9 @@
 // An integrator owns the committed state (time t_n and whatever history it keeps) and writes
 // trial states into the workspace:
 //   attempt(h)    tries a step of size h from the committed state; the workspace then holds the
-//                 trial state at t_n + h with frames, blocks, v' and lambda up to date. False if
-//                 the step could not be computed (Newton failed, singular matrix, NaN).
+//                 trial state at t_n + h with frames, blocks, v' and lambda up to date (or, if
+//                 the integrator has refresh_blocks(), with blocks that call brings up to date).
+//                 False if the step could not be computed (Newton failed, singular matrix, NaN).
 //   error_norm()  the local error of the last attempt in units of the tolerance (accept <= 1).
 //   accept()      commits the attempt and proposes the next step size from its error.
 //   reject()      rolls back and proposes a shorter step; throws SolverError once it is hopeless.
