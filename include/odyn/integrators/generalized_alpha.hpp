@@ -246,7 +246,8 @@ class GeneralizedAlpha {
     blocks_stale_ = false;
   }
 
-  /// Puts the workspace back at the last committed state.
+  /// Puts the workspace back at the last committed state, its blocks and forces evaluated there
+  /// (a restart leaves them at a probe a microsecond later otherwise).
   void rollback() {
     ws_.q = q_n_;
     ws_.v = v_n_;
@@ -255,6 +256,8 @@ class GeneralizedAlpha {
     ws_.t = t_n_;
     update_frames(model_, ws_);
     evaluate_constraints(model_, ws_);
+    evaluate_forces(model_, ws_);
+    blocks_stale_ = false;
   }
 
   /// Rolls back and throws the SolverError that describes the last failed attempt.
