@@ -184,10 +184,8 @@ class GeneralizedAlpha {
 
   /// Accepts the trial state of the last successful attempt.
   void commit() {
-    if (solver_.rank_deficiency() > 0) {
-      refresh_blocks();
-      make_multipliers_minimum_norm(model_, ws_);
-    }
+    // Redundant constraints never take the contraction shortcut, so the blocks are current here.
+    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     a_previous_ = a_step_;
     a_n_ =
