@@ -1,5 +1,6 @@
 // Speed on the flagship engine (shared/specs/engine.md):
-//  - one time step per integrator setting and per saddle-point solver,
+//  - one time step per integrator setting and per saddle-point solver (generalized-alpha, HHT,
+//    explicit Adams-Bashforth),
 //  - a whole 1 s run with its crank-angle error against the minimal-coordinate reference,
 //  - the evaluation of Phi, Phi_q, M and Q, and an explicit stage's parts (evaluations,
 //    saddle-point factorization, solve),
@@ -19,12 +20,13 @@ namespace bench_engine {
 
 using Model = engine::Model;
 
-template <class Solver>
-void step(benchmark::State& state, odyn::GeneralizedAlphaSettings settings) {
+/// Steps of h = 1e-4 s of an integrator with its settings, through whole cycles.
+template <class Integrator>
+void step_with(benchmark::State& state, typename Integrator::Settings settings) {
   engine::Engine e = engine::build();
   odyn::Workspace<Model> ws(e.model);
   odyn::assemble(e.model, ws);
-  auto integrator = std::make_unique<odyn::GeneralizedAlpha<Model, Solver>>(e.model, ws, settings);
+  auto integrator = std::make_unique<Integrator>(e.model, ws, settings);
   const double h = 1e-4;
   for (auto _ : state) {
     // Steps through the whole cycle (events included); start over after a simulated second.
@@ -32,7 +34,7 @@ void step(benchmark::State& state, odyn::GeneralizedAlphaSettings settings) {
       state.PauseTiming();
       ws = odyn::Workspace<Model>(e.model);
       odyn::assemble(e.model, ws);
-      integrator = std::make_unique<odyn::GeneralizedAlpha<Model, Solver>>(e.model, ws, settings);
+      integrator = std::make_unique<Integrator>(e.model, ws, settings);
       state.ResumeTiming();
     }
     odyn::advance_to(e.model, ws, *integrator, integrator->time() + h, h);
@@ -40,6 +42,11 @@ void step(benchmark::State& state, odyn::GeneralizedAlphaSettings settings) {
   const auto& stats = integrator->statistics();
   state.counters["newton_per_step"] = double(stats.newton_iterations) / double(stats.steps);
   state.counters["factorizations_per_step"] = double(stats.factorizations) / double(stats.steps);
+}
+
+template <class Solver>
+void step(benchmark::State& state, odyn::GeneralizedAlphaSettings settings) {
+  step_with<odyn::GeneralizedAlpha<Model, Solver>>(state, settings);
 }
 
 void StepGeneralizedAlpha(benchmark::State& state) {
@@ -59,9 +66,17 @@ BENCHMARK(StepGeneralizedAlphaDenseLu);
 BENCHMARK(StepGeneralizedAlphaRho05);
 BENCHMARK(StepHht);
 
-/// The standard 1 s run at step h (in microseconds as the argument), with its error.
+/// Explicit Adams-Bashforth of the order given as the argument (start-up steps included).
+void StepAdams(benchmark::State& state) {
+  step_with<odyn::AdamsBashforth<Model>>(state, {.order = int(state.range(0))});
+}
+BENCHMARK(StepAdams)->Arg(5)->Arg(6);
+
+/// The standard 1 s run at step h (in microseconds as the first argument), with its error;
+/// generalized-alpha, or with a second argument, Adams-Bashforth of that order.
 void Run(benchmark::State& state) {
   const double h = double(state.range(0)) * 1e-6;
+  const int adams_order = state.range(1) > 0 ? int(state.range(1)) : 0;
   static const auto reference = engine_reference::solve(1.0, 1e-3);
   double theta_error = 0.0, z_error = 0.0, seconds = 0.0;
   long steps = 0;
@@ -70,6 +85,7 @@ void Run(benchmark::State& state) {
     odyn::Workspace<Model> ws(e.model);
     odyn::DynamicsSettings settings;
     settings.step = h;
+    if (adams_order > 0) settings.integrator = "adams", settings.adams.order = adams_order;
     std::size_t k = 0;
     z_error = 0.0;
     const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& s) {
@@ -85,7 +101,15 @@ void Run(benchmark::State& state) {
   state.counters["steps"] = double(steps);
   state.counters["us_per_step"] = 1e6 * seconds / double(steps);  // of the last run
 }
-BENCHMARK(Run)->Arg(200)->Arg(100)->Arg(50)->Arg(25)->Unit(benchmark::kMillisecond);
+BENCHMARK(Run)
+    ->Args({200, 0})
+    ->Args({100, 0})
+    ->Args({50, 0})
+    ->Args({25, 0})
+    ->Args({200, 6})
+    ->Args({100, 5})
+    ->Args({100, 6})
+    ->Unit(benchmark::kMillisecond);
 
 /// Phi and Phi_q, M (the Newton matrix's mass part) and Q at one state.
 void EvaluateBlocks(benchmark::State& state) {

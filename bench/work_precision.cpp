@@ -41,6 +41,7 @@ struct Setting {
   bool adaptive = false;   // error control (rtol = atol = tolerance) or fixed step h
   double value = 0.0;      // the tolerance or the step
   double rho_inf = 0.9;
+  int order = 6;  // of adams
 };
 
 /// What one run measured: errors against the reference (named per case) and the counters.
@@ -63,6 +64,7 @@ odyn::DynamicsSettings settings_for(const Setting& s) {
   odyn::DynamicsSettings settings;
   settings.integrator = s.integrator;
   settings.generalized_alpha.rho_inf = s.rho_inf;
+  settings.adams.order = s.order;
   if (s.adaptive) {
     settings.rtol = settings.atol = s.value;
     settings.generalized_alpha.adaptive = true;
@@ -89,6 +91,8 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
   for (double h : steps)
     ladder.push_back({"generalized-alpha, fixed h", "generalized-alpha", false, h});
   for (double h : steps) ladder.push_back({"hht, fixed h", "hht", false, h});
+  if (known_integrator("adams"))
+    for (double h : steps) ladder.push_back({"adams 6, fixed h", "adams", false, 2.0 * h});
   for (double tol : loose)
     ladder.push_back({"generalized-alpha, adaptive", "generalized-alpha", true, tol});
   for (const std::string name : {"dopri5", "dop853", "bdf"})

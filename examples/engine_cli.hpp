@@ -3,7 +3,7 @@
 // `slider_crank_planar`): options, the CSV of the paper's outputs and the summary.
 //
 //   NAME [--h STEP] [--t-end T] [--dt-out DT] [--out FILE] [--integrator NAME] [--rho-inf R]
-//        [--rtol R] [--atol A]
+//        [--order K] [--rtol R] [--atol A]
 
 #include <cstdio>
 #include <cstdlib>
@@ -34,10 +34,12 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
   odyn::DynamicsSettings settings;
   std::string out_path = program + ".csv";
   const auto usage = [&] {
-    std::cerr << "usage: " << program
-              << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
-                 "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf] [--rho-inf R]\n"
-                 "       [--rtol R] [--atol A]   (error control: --h is then the first step)\n";
+    std::cerr
+        << "usage: " << program
+        << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
+           "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf|adams] [--rho-inf R]\n"
+           "       [--order K (adams, 1 to 6)] [--rtol R] [--atol A]   (error control: --h is then "
+           "the first step)\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
   for (int i = 1; i < argc; ++i) {
@@ -61,6 +63,8 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
       out_path = value;
     else if (option == "--integrator")
       settings.integrator = value;
+    else if (option == "--order")
+      settings.adams.order = static_cast<int>(cli::number(program, "--order", value));
     else if (option == "--rho-inf")
       settings.generalized_alpha.rho_inf = cli::number(program, "--rho-inf", value);
     else if (option == "--rtol")

@@ -239,6 +239,15 @@ def _settings(step: float, t_end: float, output_interval: float, integrator: str
     return settings
 
 
+def _check_order(order: Optional[int]) -> Optional[int]:
+    """The order of "adams": an integer from 1 to 6, or None for its default."""
+    if order is None:
+        return None
+    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= 6:
+        raise SceneError(f"order: expected an integer from 1 to 6, got {order!r}")
+    return order
+
+
 def _warn_redundant(result: Result) -> None:
     equations = result.redundant_equations
     if equations:
@@ -270,15 +279,18 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
              newton_rtol: Optional[float] = None, newton_atol: Optional[float] = None,
              constraint_tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None,
-             projection_tolerance: Optional[float] = None) -> Result:
+             projection_tolerance: Optional[float] = None,
+             order: Optional[int] = None) -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
     rho_inf) or "hht" take fixed steps of at most `step`, or, with error control (`adaptive`;
     on by default when rtol or atol is given), steps from the local error estimate starting at
     `step`; "dopri5" and "dop853" (explicit Dormand-Prince 5(4) and 8(5,3), positions projected
-    onto the constraints to `projection_tolerance`) and "bdf" always control their error. rtol and atol (default 1e-6) are the
-    local error tolerances per component of (q, v); max_step bounds an adaptive step.
+    onto the constraints to `projection_tolerance`) and "bdf" always control their error;
+    "adams" (explicit Adams-Bashforth of `order` 1 to 6, default 5) takes fixed steps of at most
+    `step`, for problems that are not stiff. rtol and atol (default 1e-6) are the local error
+    tolerances per component of (q, v); max_step bounds an adaptive step.
     newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
     iteration of generalized-alpha and hht.
 
@@ -292,7 +304,8 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
                          max_step, adaptive, newton_rtol=newton_rtol, newton_atol=newton_atol,
                          constraint_tolerance=constraint_tolerance,
                          max_iterations=max_iterations,
-                         projection_tolerance=projection_tolerance)
+                         projection_tolerance=projection_tolerance,
+                         order=_check_order(order))
     data = _core.simulate(model._core, settings, progress)
     error = data.pop("error")
     if error is None:

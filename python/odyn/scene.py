@@ -13,7 +13,7 @@
       "analysis": {"integrator": "generalized-alpha", "rho_inf": 0.9, "step": 1e-4,
                    "t_end": 1.0, "output_interval": 1e-3},   (+ rtol, atol, max_step,
                    adaptive, newton_rtol, newton_atol, constraint_tolerance, max_iterations,
-                   projection_tolerance; the integrator is a name of odyn.integrators())
+                   projection_tolerance, order; the integrator is a name of odyn.integrators())
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"}, ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
@@ -50,7 +50,7 @@ TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forc
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf": 0.9,
                                      "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
 ANALYSIS_OPTIONAL = ("rtol", "atol", "max_step", "adaptive", "newton_rtol", "newton_atol",
-                     "constraint_tolerance", "max_iterations", "projection_tolerance")
+                     "constraint_tolerance", "max_iterations", "projection_tolerance", "order")
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
@@ -164,6 +164,11 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
             elif key == "max_iterations":
                 if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < 1:
                     fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
+                out[key] = d[key]
+            elif key == "order":
+                if not isinstance(d[key], int) or isinstance(d[key], bool) or \
+                        not 1 <= d[key] <= 6:
+                    fail(f"{where}.{key}", f"expected an integer from 1 to 6, got {d[key]!r}")
                 out[key] = d[key]
             else:
                 out[key] = check_number(d[key], f"{where}.{key}", positive=True)

@@ -48,6 +48,7 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   ga.max_iterations = get(d, "max_iterations", ga.max_iterations);
   auto& dp = s.dormand_prince;
   dp.projection_tolerance = get(d, "projection_tolerance", dp.projection_tolerance);
+  s.adams.order = get(d, "order", s.adams.order);
   s.assembly = assembly_settings(d);
   return s;
 }

@@ -14,6 +14,7 @@
 
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/integrators/adams.hpp"
 #include "odyn/integrators/bdf.hpp"
 #include "odyn/integrators/dop853.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
@@ -30,7 +31,7 @@ struct DynamicsSettings {
   double output_interval = 1e-3;  // s
   /// By name (see integrator_names()): "generalized-alpha" or "hht" (fixed step, or error
   /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
-  /// control).
+  /// control), "adams" (fixed step, order adams.order).
   std::string integrator = "generalized-alpha";
   /// Local error tolerances of the runs with error control, per component of (q, v).
   double rtol = 1e-6;
@@ -39,6 +40,7 @@ struct DynamicsSettings {
   GeneralizedAlphaSettings generalized_alpha = {};
   DormandPrinceSettings dormand_prince = {};  // dopri5 and dop853
   BdfSettings bdf = {};
+  AdamsSettings adams = {};
   AssemblySettings assembly = {};
 };
 
@@ -250,6 +252,10 @@ template <>
 inline BdfSettings integrator_settings(const DynamicsSettings& s) {
   return s.bdf;
 }
+template <>
+inline AdamsSettings integrator_settings(const DynamicsSettings& s) {
+  return s.adams;
+}
 
 inline StepControl step_control(const DynamicsSettings& s) {
   return StepControl{
@@ -269,6 +275,7 @@ inline const std::vector<std::pair<std::string, std::string>>& integrator_names(
       {"dopri5", "explicit Dormand-Prince 5(4), index 1 with projection, rtol/atol"},
       {"dop853", "explicit Dormand-Prince 8(5,3), index 1 with projection, rtol/atol"},
       {"bdf", "implicit BDF of orders 1-5, stabilized index 2 (GGL), rtol/atol"},
+      {"adams", "explicit Adams-Bashforth of order 1-6, index 1 with projection, fixed step h"},
   };
   return names;
 }
@@ -331,6 +338,7 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);
   if (s.integrator == "dop853") return simulate_with<DormandPrince853>(model, ws, s, observe);
   if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe);
+  if (s.integrator == "adams") return simulate_with<AdamsBashforth>(model, ws, s, observe);
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
   throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);
