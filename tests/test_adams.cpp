@@ -13,6 +13,7 @@
 #include <odyn/odyn.hpp>
 
 #include "engine_model.hpp"
+#include "reference/elliptic.hpp"
 #include "reference/engine_reference.hpp"
 #include "stiff_chain_model.hpp"
 
@@ -30,23 +31,13 @@ odyn::DynamicsSettings adams(double step, int order) {
   return settings;
 }
 
-/// The complete elliptic integral of the first kind K(k), by the arithmetic-geometric mean.
-double elliptic_k(double k) {
-  double a = 1.0, b = std::sqrt(1.0 - k * k);
-  for (int i = 0; i < 30; ++i) {
-    const double mean = 0.5 * (a + b);
-    b = std::sqrt(a * b);
-    a = mean;
-  }
-  return std::numbers::pi / (2.0 * a);
-}
-
 /// A 1 m, 1 kg bar swinging about one end, released at rest from 2 rad: after one period
 /// T = 4 sqrt(I_O / (m g d)) K(sin 1) it is back at 2 rad, at rest. Returns the largest error
 /// of angle and angular velocity there, after `steps` equal steps.
 double pendulum_error(int steps, int order) {
   constexpr double theta0 = 2.0, g = 9.81, inertia_o = 1.0 / 3.0, d = 0.5;
-  const double period = 4.0 * std::sqrt(inertia_o / (d * g)) * elliptic_k(std::sin(theta0 / 2));
+  const double period =
+      4.0 * std::sqrt(inertia_o / (d * g)) * reference::elliptic_k(std::sin(theta0 / 2));
   pl::DefaultModel model;
   const auto bar = model.add_body({.name = "bar",
                                    .mass = 1.0,

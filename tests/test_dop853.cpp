@@ -15,6 +15,7 @@
 #include "andrews_model.hpp"
 #include "engine_model.hpp"
 #include "reference/andrews_reference.hpp"
+#include "reference/elliptic.hpp"
 #include "reference/engine_reference.hpp"
 #include "reference/steady_top.hpp"
 
@@ -32,24 +33,14 @@ odyn::DynamicsSettings with_tolerance(const char* integrator, double tolerance) 
   return settings;
 }
 
-/// The complete elliptic integral of the first kind K(k), by the arithmetic-geometric mean.
-double elliptic_k(double k) {
-  double a = 1.0, b = std::sqrt(1.0 - k * k);
-  for (int i = 0; i < 30; ++i) {
-    const double mean = 0.5 * (a + b);
-    b = std::sqrt(a * b);
-    a = mean;
-  }
-  return std::numbers::pi / (2.0 * a);
-}
-
 /// A bar of 1 m and 1 kg swinging about one end, released at rest from theta0 = 2 rad. Exact:
 /// the period T = 4 sqrt(I_O / (m g d)) K(sin(theta0 / 2)); at T/4 and 3T/4 the bar hangs
 /// straight down at the speed energy gives it, sqrt(2 m g d (1 - cos theta0) / I_O); at T/2 it
 /// is at -theta0 and at T back at theta0, both at rest.
 struct Pendulum {
   static constexpr double theta0 = 2.0, g = 9.81, inertia_o = 1.0 / 3.0, d = 0.5;
-  double period = 4.0 * std::sqrt(inertia_o / (d * g)) * elliptic_k(std::sin(theta0 / 2.0));
+  double period =
+      4.0 * std::sqrt(inertia_o / (d * g)) * reference::elliptic_k(std::sin(theta0 / 2.0));
   double bottom_speed = std::sqrt(2.0 * g * d * (1.0 - std::cos(theta0)) / inertia_o);
 
   /// Largest errors of angle and angular velocity at the quarter periods (outputs there,

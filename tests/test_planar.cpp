@@ -17,6 +17,7 @@
 #include <odyn/odyn.hpp>
 
 #include "four_bar_model.hpp"
+#include "reference/elliptic.hpp"
 
 namespace test_planar {
 
@@ -204,17 +205,6 @@ TEST_CASE("planar joint angle counts turns and starts from the axes", "[planar][
 
 namespace {
 
-/// Complete elliptic integral of the first kind K(k), by the arithmetic-geometric mean.
-double elliptic_k(double k) {
-  double a = 1.0, b = std::sqrt(1.0 - k * k);
-  for (int i = 0; i < 30; ++i) {
-    const double mean = 0.5 * (a + b);
-    b = std::sqrt(a * b);
-    a = mean;
-  }
-  return std::numbers::pi / (2.0 * a);
-}
-
 /// Generalized forces of one force element on two free bodies, and its potential energy.
 template <class E>
 struct ForceProbe {
@@ -327,7 +317,8 @@ TEST_CASE("planar compound pendulum: large-amplitude period", "[planar][dynamics
     t_prev = state.t;
     w_prev = w;
   });
-  const double period = 4.0 * std::sqrt((1.0 / 3.0) / (0.5 * g)) * elliptic_k(std::sin(theta0 / 2));
+  const double period =
+      4.0 * std::sqrt((1.0 / 3.0) / (0.5 * g)) * reference::elliptic_k(std::sin(theta0 / 2));
   REQUIRE(turns.size() >= 2);
   CHECK(2.0 * turns[0] == Approx(period).epsilon(1e-6));
   CHECK(turns[1] - turns[0] == Approx(period / 2.0).epsilon(1e-6));
