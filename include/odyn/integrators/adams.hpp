@@ -28,6 +28,7 @@
 #include <cmath>
 #include <string>
 
+#include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
@@ -67,7 +68,8 @@ class AdamsBashforth {
         starter_(model, ws,
                  DormandPrinceSettings{settings.projection_tolerance,
                                        settings.max_projection_iterations},
-                 control) {
+                 control),
+        projection_(model) {
     if (settings.order < 1 || settings.order > kMaxOrder)
       throw ModelError("adams", "the order must lie in [1, " + std::to_string(kMaxOrder) +
                                     "], got " + std::to_string(settings.order));
@@ -83,9 +85,6 @@ class AdamsBashforth {
     y_new_ = y_n_;
     estimate_ = y_n_;
     for (auto& f : history_) f = y_n_;
-    rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
-    solution_ = rhs_;
-    velocity_residual_ = Eigen::VectorXd::Zero(m_);
     solver_.analyze(model);
     initialize();
   }
@@ -292,40 +291,19 @@ class AdamsBashforth {
     for (int k = 0; m_ > 0 && !(ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance);
          ++k) {
       if (k == settings_.max_projection_iterations) return false;
-      rhs_.head(nv_total_).setZero();
-      rhs_.tail(m_) = -ws_.phi;
-      solver_.solve(rhs_, solution_);
+      projection_.correct_positions(model_, ws_, solver_);
       ++statistics_.newton_iterations;
-      for (int b = 0; b < model_.num_bodies(); ++b)
-        Model::Space::integrate(Eigen::Matrix<double, nq, 1>(ws_.q.template segment<nq>(b * nq)),
-                                solution_.template segment<nv>(b * nv),
-                                ws_.q.template segment<nq>(b * nq));
-      update_frames(model_, ws_);
-      evaluate_constraints(model_, ws_);
       moved = true;
     }
     // v' and lambda feed the history: solved with the matrix at the final positions.
     if (moved && !factorize()) return false;
-    if (m_ > 0) {
-      jacobian_times(model_, ws_, ws_.v, velocity_residual_);
-      velocity_residual_ += ws_.phi_t;
-      if (!(velocity_residual_.cwiseAbs().maxCoeff() <= settings_.velocity_tolerance)) {
-        rhs_.head(nv_total_).setZero();
-        rhs_.tail(m_) = -velocity_residual_;
-        solver_.solve(rhs_, solution_);
-        ++statistics_.newton_iterations;
-        ws_.v += solution_.head(nv_total_);
-        update_frames(model_, ws_);
-      }
+    if (m_ > 0 && !(projection_.velocity_residual(model_, ws_).cwiseAbs().maxCoeff() <=
+                    settings_.velocity_tolerance)) {
+      projection_.correct_velocities(model_, ws_, solver_);
+      ++statistics_.newton_iterations;
     }
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
-    rhs_.head(nv_total_) = ws_.force;
-    rhs_.tail(m_) = ws_.gamma;
-    solver_.solve(rhs_, solution_);
-    ws_.vdot = solution_.head(nv_total_);
-    ws_.lambda = solution_.tail(m_);
-    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
+    return projection_.solve_accelerations(model_, ws_, solver_) && ws_.q.allFinite() &&
+           ws_.v.allFinite();
   }
 
   bool factorize() {
@@ -339,6 +317,7 @@ class AdamsBashforth {
   StepControl control_;
   DormandPrince<Model, Solver> starter_;
   Solver solver_;
+  ConstraintProjection<Model> projection_;
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0;
@@ -348,7 +327,7 @@ class AdamsBashforth {
   std::array<double, kMaxOrder + 1> nodes_{};      // of the cached weights
   std::array<double, kMaxOrder + 1> weights_{}, error_weights_{};
   int estimate_points_ = 0;  // derivatives the cached estimate weights use; 0: none cached
-  Eigen::VectorXd y_n_, y_new_, estimate_, vdot_n_, lambda_n_, rhs_, solution_, velocity_residual_;
+  Eigen::VectorXd y_n_, y_new_, estimate_, vdot_n_, lambda_n_;
 };
 
 }  // namespace odyn

@@ -39,6 +39,7 @@
 #include <limits>
 #include <string>
 
+#include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/diagnosis.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -80,6 +81,7 @@ class Bdf {
         ws_(ws),
         settings_(settings),
         control_(control),
+        projection_(model),
         proposed_step_(std::min(control.first_step, control.max_step)) {
     if (!(control.rtol > 0.0) || !(control.atol > 0.0))
       throw ModelError("bdf", "rtol and atol must be positive, got " + to_text(control.rtol) +
@@ -175,29 +177,12 @@ class Bdf {
     if (m_ > 0) {
       // One correction of Phi in the mass metric, then of Phi_q v + Phi_t: the interpolant is
       // off the constraints by the local error only.
-      rhs_.head(nv_total_).setZero();
-      rhs_.tail(m_) = -ws_.phi;
-      output_solver_.solve(rhs_, solution_);
-      for (int b = 0; b < model_.num_bodies(); ++b)
-        Space::integrate(Eigen::Matrix<double, nq, 1>(ws_.q.template segment<nq>(b * nq)),
-                         solution_.template segment<nv>(b * nv),
-                         ws_.q.template segment<nq>(b * nq));
-      update_frames(model_, ws_);
-      evaluate_constraints(model_, ws_);
-      jacobian_times(model_, ws_, ws_.v, velocity_residual_);
-      rhs_.tail(m_) = -(velocity_residual_ + ws_.phi_t);
-      output_solver_.solve(rhs_, solution_);
-      ws_.v += solution_.head(nv_total_);
-      update_frames(model_, ws_);
+      projection_.correct_positions(model_, ws_, output_solver_);
+      projection_.velocity_residual(model_, ws_);
+      projection_.correct_velocities(model_, ws_, output_solver_);
     }
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
-    rhs_.head(nv_total_) = ws_.force;
-    rhs_.tail(m_) = ws_.gamma;
-    output_solver_.solve(rhs_, solution_);
-    ws_.vdot = solution_.head(nv_total_);
-    ws_.lambda = solution_.tail(m_);
-    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
+    return projection_.solve_accelerations(model_, ws_, output_solver_) && ws_.q.allFinite() &&
+           ws_.v.allFinite();
   }
 
   /// Positions and velocities at t from the last attempt's polynomial, and the frames.
@@ -424,8 +409,6 @@ class Bdf {
     ws_.t = t;
     update_frames(model_, ws_);
     evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
     ++statistics_.residual_evaluations;
     ++statistics_.factorizations;
     factorized_ = false;  // the projector's factorization is reused here
@@ -433,11 +416,7 @@ class Bdf {
       throw SolverError(t,
                         "bdf: the mass-constraint matrix is singular; check for redundant or "
                         "locked constraints");
-    rhs_.head(nv_total_) = ws_.force;
-    rhs_.tail(m_) = ws_.gamma;
-    projector_.solve(rhs_, solution_);
-    ws_.vdot = solution_.head(nv_total_);
-    ws_.lambda = solution_.tail(m_);
+    projection_.solve_accelerations(model_, ws_, projector_);
   }
 
   /// Predictor weights (extrapolation through the last k+1 values) and the corrector
@@ -635,6 +614,7 @@ class Bdf {
   Solver solver_;         // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
   Solver projector_;      // [M, Phi_q^T; Phi_q, 0]
   Solver output_solver_;  // the same matrix at interpolated output points
+  ConstraintProjection<Model> projection_;
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, ny_ = 0;
   double t_n_ = 0.0, h_ = 0.0, c_ = 1.0, c_factorized_ = 1.0;

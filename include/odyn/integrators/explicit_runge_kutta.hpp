@@ -24,6 +24,7 @@
 #include <limits>
 #include <string>
 
+#include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
@@ -81,6 +82,7 @@ class ExplicitRungeKutta {
         ws_(ws),
         settings_(settings),
         control_(control),
+        projection_(model),
         proposed_step_(std::min(control.first_step, control.max_step)) {
     if (!(control.rtol > 0.0) || !(control.atol > 0.0))
       throw ModelError(Method::name, "rtol and atol must be positive, got " +
@@ -101,9 +103,6 @@ class ExplicitRungeKutta {
     for (auto& term : dense_terms_) term = y_n_;
     vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
     lambda_trial_ = Eigen::VectorXd::Zero(m_);
-    rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
-    velocity_residual_ = Eigen::VectorXd::Zero(m_);
-    solution_ = rhs_;
     solver_.analyze(model);
     initialize();
   }
@@ -330,15 +329,7 @@ class ExplicitRungeKutta {
 
   /// v' and lambda at the workspace's frames (constraints evaluated), factorizing afresh.
   bool accelerations() {
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
-    if (!factorize()) return false;
-    rhs_.head(nv_total_) = ws_.force;
-    rhs_.tail(m_) = ws_.gamma;
-    solver_.solve(rhs_, solution_);
-    ws_.vdot = solution_.head(nv_total_);
-    ws_.lambda = solution_.tail(m_);
-    return solution_.allFinite();
+    return factorize() && projection_.solve_accelerations(model_, ws_, solver_);
   }
 
   bool factorize() {
@@ -395,38 +386,18 @@ class ExplicitRungeKutta {
     for (int k = 0; m_ > 0 && !(ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance);
          ++k) {
       if (k == settings_.max_projection_iterations) return false;
-      // [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]: the smallest correction in the mass metric.
-      rhs_.head(nv_total_).setZero();
-      rhs_.tail(m_) = -ws_.phi;
-      solver_.solve(rhs_, solution_);
+      projection_.correct_positions(model_, ws_, solver_);
       ++statistics_.newton_iterations;
-      for (int b = 0; b < model_.num_bodies(); ++b)
-        Model::Space::integrate(Eigen::Matrix<double, nq, 1>(ws_.q.template segment<nq>(b * nq)),
-                                solution_.template segment<nv>(b * nv),
-                                ws_.q.template segment<nq>(b * nq));
-      update_frames(model_, ws_);
-      evaluate_constraints(model_, ws_);
       matrix_at_positions = false;
     }
     if (!matrix_at_positions && !output_point && !factorize()) return false;
     if (m_ > 0) {
-      // Velocities: [M Phi_q^T; Phi_q 0] [dv; mu] = [0; -(Phi_q v + Phi_t)].
-      jacobian_times(model_, ws_, ws_.v, velocity_residual_);
-      rhs_.head(nv_total_).setZero();
-      rhs_.tail(m_) = -(velocity_residual_ + ws_.phi_t);
-      solver_.solve(rhs_, solution_);
-      ws_.v += solution_.head(nv_total_);
-      update_frames(model_, ws_);
+      projection_.velocity_residual(model_, ws_);
+      projection_.correct_velocities(model_, ws_, solver_);
     }
     // v' and lambda at the projected state: the same matrix, new right-hand side.
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
-    rhs_.head(nv_total_) = ws_.force;
-    rhs_.tail(m_) = ws_.gamma;
-    solver_.solve(rhs_, solution_);
-    ws_.vdot = solution_.head(nv_total_);
-    ws_.lambda = solution_.tail(m_);
-    return ws_.q.allFinite() && ws_.v.allFinite() && solution_.allFinite();
+    return projection_.solve_accelerations(model_, ws_, solver_) && ws_.q.allFinite() &&
+           ws_.v.allFinite();
   }
 
   const Model& model_;
@@ -434,12 +405,13 @@ class ExplicitRungeKutta {
   Settings settings_;
   StepControl control_;
   Solver solver_;
+  ConstraintProjection<Model> projection_;
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, size_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0, proposed_step_ = 1e-4;
   double previous_error_ = 1e-4;  // of the last accepted step, for PI control
   bool rejected_ = false;         // the last attempt was rejected
-  Eigen::VectorXd y_n_, y_new_, stage_, rhs_, solution_, velocity_residual_, vdot_n_, lambda_n_;
+  Eigen::VectorXd y_n_, y_new_, stage_, vdot_n_, lambda_n_;
   // Stage derivatives of the last attempt, f at its projected end, the extra dense stages.
   std::array<Eigen::VectorXd, num_derivatives> k_;
   // The last attempt's projected end state, its v' and lambda; a dense-output point.

@@ -15,6 +15,7 @@
 #include <limits>
 #include <string>
 
+#include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/diagnosis.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -59,7 +60,8 @@ class GeneralizedAlpha {
         ws_(ws),
         settings_(settings),
         control_(control),
-        proposed_step_(std::min(control.first_step, control.max_step)) {
+        proposed_step_(std::min(control.first_step, control.max_step)),
+        projection_(model) {
     if (settings.adaptive &&
         (!(control.rtol > 0.0) || !(control.atol > 0.0) || !(proposed_step_ > 0.0)))
       throw ModelError(settings.hht ? "hht" : "generalized-alpha",
@@ -279,22 +281,15 @@ class GeneralizedAlpha {
   /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the workspace's
   /// state. Uses the iteration matrix's storage; the next step factorizes afresh.
   void consistent_accelerations() {
-    const int n = nv_total_;
     update_frames(model_, ws_);
     evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
-    evaluate_gamma(model_, ws_);
     ++statistics_.factorizations;
     factorized_ = false;
     if (!solver_.factorize(model_, ws_, IterationFactors{}))
       throw SolverError(ws_.t,
                         "the mass-constraint matrix is singular; check for redundant or "
                         "locked constraints");
-    residual_.head(n) = ws_.force;
-    residual_.tail(m_) = ws_.gamma;
-    solver_.solve(residual_, correction_);
-    ws_.vdot = correction_.head(n);
-    ws_.lambda = correction_.tail(m_);
+    projection_.solve_accelerations(model_, ws_, solver_);
   }
 
   /// The state at t_{n+1} from the current guess of v'_{n+1}, written into the workspace.
@@ -490,6 +485,7 @@ class GeneralizedAlpha {
   Eigen::VectorXd a_previous_;  // (nv_total) a_{n-1}
   Eigen::VectorXd local_error_, error_scale_;  // (nv_total)
   Solver solver_;
+  ConstraintProjection<Model> projection_;
   IntegratorStatistics statistics_;
 };
 

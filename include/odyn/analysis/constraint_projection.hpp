@@ -1,0 +1,85 @@
+#pragma once
+// The steps that integrators take with a saddle-point solver factorized on the mass terms,
+// [M Phi_q^T; Phi_q 0]: the accelerations and multipliers at a state, and the corrections that
+// move a state onto Phi = 0 and Phi_q v + Phi_t = 0 by the least distance in the mass metric.
+// The integrators differ in when they factorize and how many corrections they take (explicit
+// methods after every step, Adams only where the state has drifted, BDF at output points); the
+// steps themselves are written once, here.
+
+#include <Eigen/Core>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/core/workspace.hpp"
+
+namespace odyn {
+
+template <class Model>
+class ConstraintProjection {
+ public:
+  static constexpr int nq = Model::nq;
+  static constexpr int nv = Model::nv;
+
+  /// Sizes the buffers for the model: the steps below allocate nothing.
+  explicit ConstraintProjection(const Model& model)
+      : nv_total_(model.num_velocities()),
+        m_(model.num_equations()),
+        rhs_(Eigen::VectorXd::Zero(nv_total_ + m_)),
+        solution_(rhs_),
+        velocity_residual_(Eigen::VectorXd::Zero(m_)) {}
+
+  /// v' and lambda at the workspace's state (frames and constraints evaluated, the solver
+  /// factorized there): forces and gamma are evaluated, then [M Phi_q^T; Phi_q 0] [v'; lambda]
+  /// = [Q; gamma] is solved. False if the solution is not finite.
+  template <class Solver>
+  bool solve_accelerations(const Model& model, Workspace<Model>& ws, Solver& solver) {
+    evaluate_forces(model, ws);
+    evaluate_gamma(model, ws);
+    rhs_.head(nv_total_) = ws.force;
+    rhs_.tail(m_) = ws.gamma;
+    solver.solve(rhs_, solution_);
+    ws.vdot = solution_.head(nv_total_);
+    ws.lambda = solution_.tail(m_);
+    return solution_.allFinite();
+  }
+
+  /// One correction of the positions towards Phi = 0: [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]
+  /// with the solver's matrix (factorized at these positions, or near them: a chord step), each
+  /// body moved by its dq on its configuration space. Frames and constraints are then evaluated
+  /// at the new positions.
+  template <class Solver>
+  void correct_positions(const Model& model, Workspace<Model>& ws, Solver& solver) {
+    rhs_.head(nv_total_).setZero();
+    rhs_.tail(m_) = -ws.phi;
+    solver.solve(rhs_, solution_);
+    for (int b = 0; b < model.num_bodies(); ++b)
+      Model::Space::integrate(Eigen::Matrix<double, nq, 1>(ws.q.template segment<nq>(b * nq)),
+                              solution_.template segment<nv>(b * nv),
+                              ws.q.template segment<nq>(b * nq));
+    update_frames(model, ws);
+    evaluate_constraints(model, ws);
+  }
+
+  /// Phi_q v + Phi_t at the workspace's state (constraints evaluated there).
+  const Eigen::VectorXd& velocity_residual(const Model& model, const Workspace<Model>& ws) {
+    jacobian_times(model, ws, ws.v, velocity_residual_);
+    velocity_residual_ += ws.phi_t;
+    return velocity_residual_;
+  }
+
+  /// Removes the velocity residual that velocity_residual() computed last:
+  /// [M Phi_q^T; Phi_q 0] [dv; mu] = [0; -(Phi_q v + Phi_t)], then the frames at the new v.
+  template <class Solver>
+  void correct_velocities(const Model& model, Workspace<Model>& ws, Solver& solver) {
+    rhs_.head(nv_total_).setZero();
+    rhs_.tail(m_) = -velocity_residual_;
+    solver.solve(rhs_, solution_);
+    ws.v += solution_.head(nv_total_);
+    update_frames(model, ws);
+  }
+
+ private:
+  Eigen::Index nv_total_ = 0, m_ = 0;
+  Eigen::VectorXd rhs_, solution_, velocity_residual_;
+};
+
+}  // namespace odyn
