@@ -13,9 +13,9 @@
 #include <odyn/odyn.hpp>
 
 #include "engine_model.hpp"
-#include "reference/elliptic.hpp"
 #include "reference/engine_reference.hpp"
 #include "stiff_chain_model.hpp"
+#include "swinging_bar.hpp"
 
 namespace test_adams {
 
@@ -35,17 +35,9 @@ odyn::DynamicsSettings adams(double step, int order) {
 /// T = 4 sqrt(I_O / (m g d)) K(sin 1) it is back at 2 rad, at rest. Returns the largest error
 /// of angle and angular velocity there, after `steps` equal steps.
 double pendulum_error(int steps, int order) {
-  constexpr double theta0 = 2.0, g = 9.81, inertia_o = 1.0 / 3.0, d = 0.5;
-  const double period =
-      4.0 * std::sqrt(inertia_o / (d * g)) * reference::elliptic_k(std::sin(theta0 / 2));
-  pl::DefaultModel model;
-  const auto bar = model.add_body({.name = "bar",
-                                   .mass = 1.0,
-                                   .inertia = 1.0 / 12.0,
-                                   .position = {d * std::sin(theta0), -d * std::cos(theta0)},
-                                   .angle = theta0});
-  model.add(pl::Revolute("pivot", odyn::ground, {}, bar, {{0.0, d}}));
-  model.add(pl::Gravity("gravity", {0.0, -g}));
+  using namespace swinging_bar;
+  const double period = swinging_bar::period();
+  pl::DefaultModel model = build();
   odyn::Workspace<pl::DefaultModel> ws(model);
   auto settings = adams(period / steps, order);
   // Drift projected at once, so that what is measured is the truncation error.

@@ -15,9 +15,9 @@
 #include "andrews_model.hpp"
 #include "engine_model.hpp"
 #include "reference/andrews_reference.hpp"
-#include "reference/elliptic.hpp"
 #include "reference/engine_reference.hpp"
 #include "reference/steady_top.hpp"
+#include "swinging_bar.hpp"
 
 namespace test_dop853 {
 
@@ -38,9 +38,9 @@ odyn::DynamicsSettings with_tolerance(const char* integrator, double tolerance) 
 /// straight down at the speed energy gives it, sqrt(2 m g d (1 - cos theta0) / I_O); at T/2 it
 /// is at -theta0 and at T back at theta0, both at rest.
 struct Pendulum {
-  static constexpr double theta0 = 2.0, g = 9.81, inertia_o = 1.0 / 3.0, d = 0.5;
-  double period =
-      4.0 * std::sqrt(inertia_o / (d * g)) * reference::elliptic_k(std::sin(theta0 / 2.0));
+  static constexpr double theta0 = swinging_bar::theta0, g = swinging_bar::g,
+                          inertia_o = swinging_bar::inertia_o, d = swinging_bar::d;
+  double period = swinging_bar::period();
   double bottom_speed = std::sqrt(2.0 * g * d * (1.0 - std::cos(theta0)) / inertia_o);
 
   /// Largest errors of angle and angular velocity at the quarter periods (outputs there,
@@ -51,14 +51,7 @@ struct Pendulum {
   };
 
   Errors run(odyn::DynamicsSettings settings) const {
-    pl::DefaultModel model;
-    const auto bar = model.add_body({.name = "bar",
-                                     .mass = 1.0,
-                                     .inertia = 1.0 / 12.0,
-                                     .position = {d * std::sin(theta0), -d * std::cos(theta0)},
-                                     .angle = theta0});
-    model.add(pl::Revolute("pivot", odyn::ground, {}, bar, {{0.0, d}}));
-    model.add(pl::Gravity("gravity", {0.0, -g}));
+    pl::DefaultModel model = swinging_bar::build();
     odyn::Workspace<pl::DefaultModel> ws(model);
     settings.t_end = period;
     settings.output_interval = period / 4.0;
