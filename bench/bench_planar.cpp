@@ -93,7 +93,6 @@ void AndrewsRun(benchmark::State& state) {
     settings.step = h;
     settings.t_end = 0.03;
     settings.output_interval = 0.03;
-    settings.generalized_alpha.newton_rtol = 1e-12;
     const auto summary = odyn::simulate(m.model, ws, settings, [](const auto&) {});
     const auto angles = andrews::test_set_angles(andrews::body_angles(m, ws));
     angle_error = 0.0;

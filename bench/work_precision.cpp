@@ -157,7 +157,6 @@ Case andrews_case(bool quick) {
     odyn::DynamicsSettings settings = base;
     settings.t_end = 0.03;
     settings.output_interval = 0.03;
-    settings.generalized_alpha.newton_rtol = 1e-12;  // short steps: see examples/andrews.cpp
     Outcome out;
     out.errors.assign(1, 0.0);
     const auto summary = odyn::simulate(m.model, ws, settings, [](const auto&) {});

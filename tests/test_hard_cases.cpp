@@ -370,7 +370,10 @@ TEST_CASE("Heavy top: conserved quantities, and second order on the rotation gro
     };
     CHECK(falls(coarse.energy, r.energy, 1e-12));
     CHECK(falls(coarse.momentum, r.momentum, 1e-12));
-    CHECK(falls(coarse.spin, r.spin, 1e-12));
+    // Omega_y is conserved by the discrete equations themselves (J_x = J_z, and the pivot's
+    // moment about the centre of mass is perpendicular to y): its error is what Newton leaves,
+    // 3e-11 to 8e-11 of the spin at h <= 2e-4.
+    CHECK(falls(coarse.spin, r.spin, 1e-10));
   }
   CHECK(runs.back().energy < 1e-4);
   CHECK(runs.back().momentum < 1e-4);

@@ -30,7 +30,8 @@ struct GeneralizedAlphaSettings {
   double rho_inf = 0.9;
   /// HHT-alpha flavour (alpha_m = 0, rho_inf in [0.5, 1]) instead of Chung-Hulbert's.
   bool hht = false;
-  /// Newton stops when the velocity correction is below atol + rtol max|v| in every entry...
+  /// Newton stops when the velocity correction is below atol + rtol max|v| in every entry, or
+  /// below the step's own accuracy if that is smaller (see newton_tolerance())...
   double newton_rtol = 1e-9;
   double newton_atol = 1e-10;
   /// ... and |Phi| is below this in every entry.
@@ -195,6 +196,7 @@ class GeneralizedAlpha {
     vdot_previous_ = vdot_n_;
     lambda_previous_ = lambda_n_;
     previous_step_ = h_;
+    previous_local_error_ = local_error_.cwiseAbs().maxCoeff();
     starting_ = false;
     q_n_ = ws_.q;
     v_n_ = ws_.v;
@@ -387,7 +389,16 @@ class GeneralizedAlpha {
       ws_.lambda = lambda_n_;
     }
     update_state(t_new);
-    double previous_norm = 0.0, previous_phi_norm = 0.0;
+    // Correction sizes are measured in units of the tight tolerance; times `loose` they are in
+    // units of the ordinary one.
+    const NewtonTolerance newton = newton_tolerance();
+    const double tolerance = newton.tight;
+    const double loose = newton.tight / newton.ordinary;
+    double previous_norm = 0.0, previous_phi_norm = 0.0, earlier_norm = 0.0;
+    // Corrections until the ordinary tolerance was met: when rounding stops the iteration short
+    // of the tight one, whether the factorization is worth keeping is judged on these alone.
+    int ordinary_iterations = 0;
+    bool ordinary_met = false;
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
       const double phi_norm = m_ == 0 ? 0.0 : ws_.phi.cwiseAbs().maxCoeff();
@@ -399,11 +410,16 @@ class GeneralizedAlpha {
                       (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_))
                           .cwiseAbs()
                           .maxCoeff() /
-                      (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff())
+                      tolerance
                 : 0.0;
-      if (k > 0 && (previous_norm <= 1.0 || next_norm <= 1.0) &&
+      // Short of the tight tolerance, the ordinary one does when iterating no longer helps:
+      // the corrections stopped shrinking (rounding), or the iterations ran out.
+      const bool tight = previous_norm <= 1.0 || next_norm <= 1.0;
+      const bool stalled =
+          k == settings_.max_iterations || (k > 1 && previous_norm > 0.5 * earlier_norm);
+      if (k > 0 && (tight || (stalled && previous_norm * loose <= 1.0)) &&
           phi_norm <= settings_.constraint_tolerance) {
-        if (k > settings_.reuse_iterations) factorized_ = false;
+        if ((tight ? k : ordinary_iterations) > settings_.reuse_iterations) factorized_ = false;
         return true;
       }
       if (k == settings_.max_iterations) return false;
@@ -414,10 +430,13 @@ class GeneralizedAlpha {
       ++statistics_.newton_iterations;
       // Size of the velocity correction in units of the tolerance.
       const double norm =
-          velocity_factor() * correction_.head(nv_total_).cwiseAbs().maxCoeff() /
-          (settings_.newton_atol + settings_.newton_rtol * ws_.v.cwiseAbs().maxCoeff());
+          velocity_factor() * correction_.head(nv_total_).cwiseAbs().maxCoeff() / tolerance;
       if (!std::isfinite(norm)) return false;
-      if (k > 0 && norm > 2.0 * previous_norm && norm > 1.0) return false;  // diverging
+      if (!ordinary_met) {
+        ++ordinary_iterations;
+        ordinary_met = norm * loose <= 1.0;
+      }
+      if (k > 0 && norm > 2.0 * previous_norm && norm * loose > 1.0) return false;  // diverging
       update_state(t_new);
       // Newton contracts the correction by about rate = norm / previous_norm per iteration, so
       // the error left after this correction is about rate / (1 - rate) times it (Hairer &
@@ -439,10 +458,42 @@ class GeneralizedAlpha {
           return true;
         }
       }
+      earlier_norm = previous_norm;
       previous_norm = norm;
       previous_phi_norm = phi_norm;
     }
     return false;
+  }
+
+  struct NewtonTolerance {
+    double ordinary;  // atol + rtol max|v|, from the settings
+    double tight;     // no larger: what the step's own accuracy asks for
+  };
+
+  /// Newton's tolerances on the velocity correction in this step. The settings' atol + rtol
+  /// max|v| suits steps whose truncation error is far larger than it. Short steps are more
+  /// accurate than that: each leaves its Newton error in the state, and the errors of many
+  /// steps add up (Andrews' mechanism at h = 2.5e-7 s, 120 000 steps, lost a digit to it).
+  /// The tight tolerance follows the step's local error instead: a small fraction of the last
+  /// step's position error per unit time, scaled by (h / h_last)^3. Rounding may stop Newton
+  /// short of it; the iteration then settles for the ordinary tolerance (see solve_step).
+  NewtonTolerance newton_tolerance() const {
+    const double largest_velocity = ws_.v.cwiseAbs().maxCoeff();
+    const double ordinary = settings_.newton_atol + settings_.newton_rtol * largest_velocity;
+    if (!(previous_local_error_ > 0.0) || !(previous_step_ > 0.0)) return {ordinary, ordinary};
+    constexpr double fraction = 1e-4;
+    const double ratio = h_ / previous_step_;
+    const double following = fraction * previous_local_error_ * ratio * ratio * ratio / h_;
+    // Rounding in v, and in Phi (whose terms are about as large as the bodies' positions),
+    // divided by h to turn it into velocity.
+    double largest_position = 0.0;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      largest_position =
+          std::max(largest_position,
+                   ws_.q.template segment<Model::Space::dim>(b * nq).cwiseAbs().maxCoeff());
+    const double rounding =
+        std::numeric_limits<double>::epsilon() * (largest_velocity + largest_position / h_);
+    return {ordinary, std::min(ordinary, std::max(following, rounding))};
   }
 
   std::string failure_message() const {
@@ -476,7 +527,8 @@ class GeneralizedAlpha {
   Eigen::VectorXd q_n_, v_n_, vdot_n_, a_n_, lambda_n_;  // state at the start of the step
   Eigen::VectorXd vdot_previous_, lambda_previous_;      // one step earlier, for the predictor
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start
-  double reference_step_ = 0.0;  // the recent steps' size: max(h, half the last reference)
+  double previous_local_error_ = 0.0;  // largest entry of its local position error estimate
+  double reference_step_ = 0.0;        // the recent steps' size: max(h, half the last reference)
   Eigen::VectorXd inverse_mass_diagonal_;  // (nv_total)
   Eigen::VectorXd jerk_;                   // (nv_total) v'' at the last restart
   bool starting_ = false;                  // the next step is the first after a restart
