@@ -10,6 +10,7 @@
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/workspace.hpp"
+#include "odyn/linalg/all_finite.hpp"
 
 namespace odyn {
 
@@ -39,7 +40,7 @@ class ConstraintProjection {
     solver.solve(rhs_, solution_);
     ws.vdot = solution_.head(nv_total_);
     ws.lambda = solution_.tail(m_);
-    return solution_.allFinite();
+    return all_finite(solution_);
   }
 
   /// One correction of the positions towards Phi = 0: [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]

@@ -33,6 +33,7 @@
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -302,8 +303,8 @@ class AdamsBashforth {
       projection_.correct_velocities(model_, ws_, solver_);
       ++statistics_.newton_iterations;
     }
-    return projection_.solve_accelerations(model_, ws_, solver_) && ws_.q.allFinite() &&
-           ws_.v.allFinite();
+    return projection_.solve_accelerations(model_, ws_, solver_) && all_finite(ws_.q) &&
+           all_finite(ws_.v);
   }
 
   bool factorize() {

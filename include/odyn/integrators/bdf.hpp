@@ -44,6 +44,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/minimum_norm.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/saddle_point.hpp"
@@ -181,8 +182,8 @@ class Bdf {
       projection_.velocity_residual(model_, ws_);
       projection_.correct_velocities(model_, ws_, output_solver_);
     }
-    return projection_.solve_accelerations(model_, ws_, output_solver_) && ws_.q.allFinite() &&
-           ws_.v.allFinite();
+    return projection_.solve_accelerations(model_, ws_, output_solver_) && all_finite(ws_.q) &&
+           all_finite(ws_.v);
   }
 
   /// Positions and velocities at t from the last attempt's polynomial, and the frames.
@@ -487,7 +488,7 @@ class Bdf {
     jacobian_times(model_, ws_, ws_.v, velocity_residual_);
     velocity_residual_ += ws_.phi_t;
     rhs_.tail(m_) = -velocity_residual_;
-    return rhs_.allFinite() && ws_.phi.allFinite();
+    return all_finite(rhs_) && all_finite(ws_.phi);
   }
 
   bool factorize() {
@@ -597,7 +598,7 @@ class Bdf {
   }
 
   std::string failure_message() const {
-    if (!rhs_.allFinite() || !ws_.force.allFinite())
+    if (!all_finite(rhs_) || !all_finite(ws_.force))
       return "bdf: Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";

@@ -28,6 +28,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
@@ -316,7 +317,7 @@ class ExplicitRungeKutta {
       k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
           y.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
     k.tail(nv_total_) = ws_.vdot;
-    return k.allFinite();
+    return all_finite(k);
   }
 
   /// The derivative at the workspace's (consistent) state, whose v' is already solved.
@@ -396,8 +397,8 @@ class ExplicitRungeKutta {
       projection_.correct_velocities(model_, ws_, solver_);
     }
     // v' and lambda at the projected state: the same matrix, new right-hand side.
-    return projection_.solve_accelerations(model_, ws_, solver_) && ws_.q.allFinite() &&
-           ws_.v.allFinite();
+    return projection_.solve_accelerations(model_, ws_, solver_) && all_finite(ws_.q) &&
+           all_finite(ws_.v);
   }
 
   const Model& model_;

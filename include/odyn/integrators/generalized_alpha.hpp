@@ -20,6 +20,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
+#include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/minimum_norm.hpp"
 #include "odyn/linalg/saddle_point.hpp"
 
@@ -349,7 +350,7 @@ class GeneralizedAlpha {
     dynamics -= ws_.force;
     add_jacobian_transpose_times(model_, ws_, ws_.lambda, dynamics);
     residual_.tail(m_) = ws_.phi / position_factor();
-    return residual_.allFinite();
+    return all_finite(residual_);
   }
 
   /// Local error of the positions, c h^2 (a_{n+1} - a_n) in the bodies' tangent coordinates
@@ -497,7 +498,7 @@ class GeneralizedAlpha {
   }
 
   std::string failure_message() const {
-    if (!residual_.allFinite())
+    if (!all_finite(residual_))
       return "Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";

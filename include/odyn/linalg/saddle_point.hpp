@@ -8,7 +8,10 @@
 //  - BlockSchurSaddlePoint: when A is block diagonal (no force element couples two moving
 //    bodies in the Newton matrix), inverts A body by body and factorizes only the m x m Schur
 //    complement B A^-1 B^T; several times cheaper for small and medium models. It falls back
-//    to the dense solver by itself when A is not block diagonal.
+//    to the dense solver by itself when A is not block diagonal. S is assembled from the
+//    elements' own Jacobian blocks in the workspace, one fixed-size product per pair of
+//    blocks on a body (the pairs are listed once, by analyze, under their two element types),
+//    so no loop in factorize or solve runs over a row count known only at run time.
 //
 // Redundant constraints. When B = Phi_q is rank-deficient (a mechanism whose joints repeat one
 // another's equations, such as Bricard's linkage, or two coaxial hinges), the matrix is singular
@@ -35,9 +38,13 @@
 #include <Eigen/Core>
 #include <Eigen/LU>  // inverse() of the small fixed-size body blocks
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <type_traits>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "odyn/analysis/system.hpp"
@@ -148,7 +155,6 @@ class BlockSchurSaddlePoint {
  public:
   static constexpr int nv = Model::nv;
   using Block = Eigen::Matrix<double, nv, nv>;
-  using Columns = Eigen::Matrix<double, nv, Eigen::Dynamic>;
 
   void analyze(const Model& model) {
     dense_fallback_ = detail::couples_bodies(model);
@@ -163,36 +169,41 @@ class BlockSchurSaddlePoint {
     inverses_.assign(bodies_, Block::Zero());
     diagonal_inverse_.assign(bodies_, false);
     cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
-    // The constraint rows that act on each body, in the order in which for_each_jacobian_block
-    // visits them (pool, element, body): S = B A^-1 B^T only couples those.
-    std::vector<std::vector<int>> rows(bodies_);
-    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    // Every block of B (a constraint element's rows on one of its moving bodies), by type.
+    std::vector<std::vector<std::pair<std::size_t, BlockRef>>> on_body(bodies_);
+    std::vector<Eigen::Index> envelope_end(static_cast<std::size_t>(m_), 0);
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+      block_refs_[type].clear();
       if constexpr (Constraint<E>) {
-        for (std::size_t i = 0; i < pool.size(); ++i)
-          for (const BodyId body : pool[i].bodies())
-            if (!body.is_ground())
-              for (int r = 0; r < E::num_equations; ++r)
-                rows[body.index - 1].push_back(model.template rows<E>()[i] + r);
+        std::get<type>(weighted_).resize(pool.size());
+        for (std::size_t i = 0; i < pool.size(); ++i) {
+          const int row = model.template rows<E>()[i];
+          for (int r = row; r < row + E::num_equations; ++r)  // one element's block is full
+            envelope_end[r] = std::max<Eigen::Index>(envelope_end[r], row + E::num_equations);
+          for (int k = 0; k < E::num_bodies; ++k) {
+            const BodyId body = pool[i].bodies()[k];
+            if (body.is_ground()) continue;
+            const BlockRef ref{static_cast<int>(i), k, body.index - 1, row, E::num_equations};
+            block_refs_[type].push_back(ref);
+            on_body[body.index - 1].emplace_back(type, ref);
+          }
+        }
       }
     });
-    // One flat list of (body, row) entries, body after body: column k of the matrices below.
-    entry_rows_.clear();
-    body_begin_.assign(bodies_ + 1, 0);
-    for (int b = 0; b < bodies_; ++b) {
-      entry_rows_.insert(entry_rows_.end(), rows[b].begin(), rows[b].end());
-      body_begin_[b + 1] = static_cast<int>(entry_rows_.size());
-    }
-    const auto entries = static_cast<Eigen::Index>(entry_rows_.size());
-    transposed_ = Columns::Zero(nv, entries);
-    weighted_ = Columns::Zero(nv, entries);
-    filled_.assign(bodies_, 0);
+    // Two blocks on one body couple their rows in S (which bounds the envelope of its
+    // columns). Each pair is kept once, under the types of its lower and upper element, so
+    // that factorize multiplies blocks of fixed sizes.
+    for (auto& list : couplings_) list.clear();
+    for (const auto& blocks : on_body)
+      for (const auto& [lower_type, lower] : blocks)
+        for (const auto& [upper_type, upper] : blocks) {
+          if (lower.row <= upper.row) continue;
+          couplings_[lower_type * Model::num_types + upper_type].push_back(Coupling{lower, upper});
+          for (int column = upper.row; column < upper.row + upper.equations; ++column)
+            envelope_end[column] =
+                std::max<Eigen::Index>(envelope_end[column], lower.row + lower.equations);
+        }
     schur_ = Eigen::MatrixXd::Zero(m_, m_);
-    // Rows couple in S when they share a body: that bounds the envelope of its columns.
-    std::vector<Eigen::Index> envelope_end(static_cast<std::size_t>(m_), 0);
-    for (const auto& body_rows : rows)
-      for (const int i : body_rows)
-        for (const int j : body_rows)
-          if (i >= j) envelope_end[j] = std::max<Eigen::Index>(envelope_end[j], i + 1);
     schur_cholesky_.resize(m_, envelope_end);
     schur_lu_.resize(m_);
     // Sized by a first computation, so that a singular S later allocates nothing.
@@ -207,33 +218,35 @@ class BlockSchurSaddlePoint {
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     if (dense_fallback_) return dense_.factorize(model, ws, f);
     if (!invert_blocks(model, ws, f)) return false;
-    // B, body by body: its rows on each body, transposed (one column per constraint row).
-    std::copy(body_begin_.begin(), body_begin_.end() - 1, filled_.begin());
-    detail::for_each_jacobian_block(model, ws, [&](int, int column, const auto& block) {
-      constexpr int m = std::decay_t<decltype(block)>::RowsAtCompileTime;
-      const int b = column / nv;
-      transposed_.template middleCols<m>(filled_[b]) = block.transpose();
-      filled_[b] += m;
-    });
-    // S = sum over bodies of B_b A_b^-1 B_b^T, one fixed-size product per pair of rows.
+    // S = B A^-1 B^T, block by block: each block B_e of B (element e's rows on body b) is
+    // weighted, W_e = B_e A_b^-1, and gives S_ee += W_e B_e^T; each pair of blocks on one body
+    // gives the off-diagonal block W_e B_f^T. All sizes are fixed at compile time.
     schur_.setZero();
-    for (int b = 0; b < bodies_; ++b) {
-      const Block& inverse = inverses_[b];
-      const bool diagonal = diagonal_inverse_[b];  // principal axes at the centre of mass
-      for (int i = body_begin_[b]; i < body_begin_[b + 1]; ++i) {
-        if (diagonal)
-          weighted_.col(i) = inverse.diagonal().cwiseProduct(transposed_.col(i));
+    for_each_type([&]<class E, std::size_t T>() {
+      constexpr int m = E::num_equations;
+      const auto& blocks = std::get<T>(ws.blocks);
+      auto& weighted = std::get<T>(weighted_);
+      for (const BlockRef& ref : block_refs_[T]) {
+        const auto& jacobian = blocks[ref.element].jacobian[ref.side];
+        auto& w = weighted[ref.element][ref.side];
+        const Block& inverse = inverses_[ref.body];
+        if (diagonal_inverse_[ref.body])  // principal axes at the centre of mass
+          w = jacobian * inverse.diagonal().asDiagonal();
         else
-          weighted_.col(i).noalias() = inverse * transposed_.col(i);
-        // Into the lower triangle (rows of one body may come in any order).
-        const int row_i = entry_rows_[i];
-        for (int j = body_begin_[b]; j <= i; ++j) {
-          const int row_j = entry_rows_[j];
-          schur_(std::max(row_i, row_j), std::min(row_i, row_j)) +=
-              weighted_.col(i).dot(transposed_.col(j));
-        }
+          w.noalias() = jacobian * inverse;  // A_b^-1 is symmetric
+        schur_.template block<m, m>(ref.row, ref.row).noalias() += w * jacobian.transpose();
       }
-    }
+    });
+    for_each_type([&]<class E, std::size_t T>() {
+      for_each_type([&]<class F, std::size_t U>() {
+        const auto& weighted = std::get<T>(weighted_);
+        const auto& blocks = std::get<U>(ws.blocks);
+        for (const auto& [lower, upper] : couplings_[T * Model::num_types + U])
+          schur_.template block<E::num_equations, F::num_equations>(lower.row, upper.row)
+              .noalias() += weighted[lower.element][lower.side] *
+                            blocks[upper.element].jacobian[upper.side].transpose();
+      });
+    });
     if (m_ == 0) {
       rank_deficiency_ = 0;
       return true;
@@ -249,18 +262,12 @@ class BlockSchurSaddlePoint {
   /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
     if (dense_fallback_) return dense_.solve(rhs, solution);
-    if (m_ == 0) {
-      for (int b = 0; b < bodies_; ++b)
-        solution.segment<nv>(b * nv).noalias() = inverses_[b] * rhs.segment<nv>(b * nv);
-      return;
-    }
-    // B A^-1 f = sum over bodies of (A_b^-1 B_b^T)^T f_b.
+    // B A^-1 f = sum over the blocks of W_e f_b.
     work_m_ = -rhs.tail(m_);
-    for (int b = 0; b < bodies_; ++b) {
-      const Eigen::Matrix<double, nv, 1> f = rhs.segment<nv>(b * nv);
-      for (int k = body_begin_[b]; k < body_begin_[b + 1]; ++k)
-        work_m_[entry_rows_[k]] += weighted_.col(k).dot(f);
-    }
+    for_each_weighted([&](const BlockRef& ref, const auto& w) {
+      constexpr int m = std::decay_t<decltype(w)>::RowsAtCompileTime;
+      work_m_.template segment<m>(ref.row).noalias() += w * rhs.template segment<nv>(ref.body * nv);
+    });
     switch (method_) {
       case Method::cholesky:
         solution.tail(m_) = work_m_;
@@ -275,18 +282,71 @@ class BlockSchurSaddlePoint {
         solution.tail(m_) = work_y_;
         break;
     }
-    // x_b = A_b^-1 f_b - (A_b^-1 B_b^T) y_b.
-    const double* y = solution.data() + n_;
+    // x_b = A_b^-1 f_b - sum over the blocks on body b of W_e^T y_e.
     for (int b = 0; b < bodies_; ++b) {
-      Eigen::Matrix<double, nv, 1> x = inverses_[b] * rhs.segment<nv>(b * nv);
-      for (int k = body_begin_[b]; k < body_begin_[b + 1]; ++k)
-        x -= weighted_.col(k) * y[entry_rows_[k]];
-      solution.segment<nv>(b * nv) = x;
+      const Eigen::Matrix<double, nv, 1> f = rhs.template segment<nv>(b * nv);
+      if (diagonal_inverse_[b])
+        solution.template segment<nv>(b * nv) = inverses_[b].diagonal().cwiseProduct(f);
+      else
+        solution.template segment<nv>(b * nv).noalias() = inverses_[b] * f;
     }
+    for_each_weighted([&](const BlockRef& ref, const auto& w) {
+      constexpr int m = std::decay_t<decltype(w)>::RowsAtCompileTime;
+      solution.template segment<nv>(ref.body * nv).noalias() -=
+          w.transpose() * solution.template segment<m>(n_ + ref.row);
+    });
   }
 
  private:
   enum class Method { cholesky, lu, minimum_norm };
+
+  /// One block of B: element `element` of its type, its body number `side`, that body's index
+  /// from 0, the element's first row and its number of rows.
+  struct BlockRef {
+    int element, side, body, row, equations;
+  };
+  /// Two blocks of B on one body, the lower one's rows below the upper one's.
+  struct Coupling {
+    BlockRef lower, upper;
+  };
+
+  template <class E>
+  struct WeightedOf {
+    using type = char;  // not a constraint: nothing to keep
+  };
+  template <Constraint E>
+  struct WeightedOf<E> {
+    using type = std::array<Eigen::Matrix<double, E::num_equations, nv>, E::num_bodies>;
+  };
+  template <class>
+  struct WeightedPools;
+  template <class BodyT, class... Elements>
+  struct WeightedPools<odyn::Model<BodyT, Elements...>> {
+    using type = std::tuple<std::vector<typename WeightedOf<Elements>::type>...>;
+  };
+
+  /// f.template operator()<E, T>() for every constraint type E, T its position in the model.
+  template <class F>
+  static void for_each_type(F&& f) {
+    [&]<std::size_t... T>(std::index_sequence<T...>) {
+      (
+          [&] {
+            using E = std::variant_alternative_t<T, typename Model::Variant>;
+            if constexpr (Constraint<E>) f.template operator()<E, T>();
+          }(),
+          ...);
+    }
+    (std::make_index_sequence<Model::num_types>{});
+  }
+
+  /// f(block, W_e) for every block of B, with the weights of the last factorize.
+  template <class F>
+  void for_each_weighted(F&& f) const {
+    for_each_type([&]<class E, std::size_t T>() {
+      for (const BlockRef& ref : block_refs_[T])
+        f(ref, std::get<T>(weighted_)[ref.element][ref.side]);
+    });
+  }
 
   /// A_b^-1 for every body. With mass terms only (explicit integrators, projections,
   /// assembly) A is a multiple of the constant mass matrix: its inverses are kept and reused.
@@ -351,12 +411,10 @@ class BlockSchurSaddlePoint {
   std::vector<Block> blocks_;           // (nb) diagonal blocks of A
   std::vector<Block> inverses_;         // (nb) inverses of their symmetric parts
   std::vector<bool> diagonal_inverse_;  // (nb) inverses_[b] is diagonal (kept mass-only ones)
-  std::vector<int> entry_rows_;         // constraint rows acting on each body, body after body
-  std::vector<int> body_begin_;         // (nb + 1) each body's first entry
-  std::vector<int> filled_;             // (nb) next entry of each body to write
-  Columns transposed_;                  // (entries) B_b^T, the rows of B on body b, transposed
-  Columns weighted_;                    // (entries) A_b^-1 B_b^T
-  Eigen::MatrixXd schur_;               // (m x m) S = B A^-1 B^T
+  std::array<std::vector<BlockRef>, Model::num_types> block_refs_;  // blocks of B, by type
+  std::array<std::vector<Coupling>, Model::num_types * Model::num_types> couplings_;
+  typename WeightedPools<Model>::type weighted_;  // W_e = B_e A_b^-1, laid out like ws.blocks
+  Eigen::MatrixXd schur_;                         // (m x m) S = B A^-1 B^T
   SmallCholesky schur_cholesky_;
   PivotedLu schur_lu_;                  // S not positive definite
   RankRevealingQr schur_minimum_norm_;  // S singular
