@@ -95,6 +95,7 @@ class SmallCholesky {
     const Eigen::Index n = x.size();
     if (n == 0) return;
     double* __restrict z = x.data();
+    // L z = x, by rows of L (columns of the copy L^T); `previous` holds the last unknown found.
     double previous = z[0];
     for (Eigen::Index i = 1; i < n; ++i) {
       const double* __restrict row_i = &upper_(0, i);
@@ -104,6 +105,7 @@ class SmallCholesky {
       z[i] = sum;
       previous = sum;
     }
+    // D L^T y = z, by columns of L, from the last row.
     previous = z[n - 1] * inverse_diagonal_[n - 1];
     z[n - 1] = previous;
     for (Eigen::Index i = n - 2; i >= 0; --i) {
