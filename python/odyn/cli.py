@@ -38,6 +38,9 @@ def _parser() -> argparse.ArgumentParser:
                      "error control for generalized-alpha and hht; --h is then the first step)")
     run.add_argument("--atol", type=float, help="absolute local error tolerance (likewise)")
     run.add_argument("--max-step", type=float, help="largest step with error control, s")
+    run.add_argument("--coordinates", choices=["absolute", "joint"],
+                     help="dopri5 and dop853 on spatial models: step joint coordinates of a "
+                     "spanning tree, loops closed by constraints (default: absolute)")
     run.add_argument("--out", help="write the output columns to a .csv or .npz file")
     run.add_argument("--plot", help="draw every output column against t into this image")
     run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
@@ -131,7 +134,7 @@ def _run(args: argparse.Namespace) -> int:
     scene = load(args.scene)
     settings = dict(scene.analysis)
     for key in ("t_end", "step", "output_interval", "integrator", "rho_inf", "rtol", "atol",
-                "max_step"):
+                "max_step", "coordinates"):
         value = getattr(args, key)
         if value is not None:
             settings[key] = value

@@ -280,7 +280,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
              constraint_tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None,
              projection_tolerance: Optional[float] = None,
-             order: Optional[int] = None) -> Result:
+             order: Optional[int] = None, coordinates: str = "absolute") -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
@@ -294,6 +294,13 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
     iteration of generalized-alpha and hht.
 
+    coordinates: "absolute" (every body's position and orientation, every joint a constraint)
+    or, for spatial models with dopri5 or dop853, "joint": the bodies located through a
+    spanning tree of revolute, translational, cylindrical, universal and fixed joints, only the
+    joints that close loops (spherical joints, distances, drivers, the rest) as constraints.
+    Fewer unknowns, so each step costs less; reactions and outputs are the same as in absolute
+    coordinates. Redundant loop closures are refused (absolute coordinates handle them).
+
     The GIL is released during the run (Python callables take it back per call).
     progress(t) is called about every 0.2 s of wall time. Ctrl-C raises `odyn.Interrupted`,
     whose `result` holds the outputs so far; an error during the run gets the partial result
@@ -305,7 +312,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
                          constraint_tolerance=constraint_tolerance,
                          max_iterations=max_iterations,
                          projection_tolerance=projection_tolerance,
-                         order=_check_order(order))
+                         order=_check_order(order),
+                         coordinates=check_choice(coordinates, "coordinates",
+                                                  ["absolute", "joint"]))
     data = _core.simulate(model._core, settings, progress)
     error = data.pop("error")
     if error is None:

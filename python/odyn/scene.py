@@ -13,7 +13,8 @@
       "analysis": {"integrator": "generalized-alpha", "rho_inf": 0.9, "step": 1e-4,
                    "t_end": 1.0, "output_interval": 1e-3},   (+ rtol, atol, max_step,
                    adaptive, newton_rtol, newton_atol, constraint_tolerance, max_iterations,
-                   projection_tolerance, order; the integrator is a name of odyn.integrators())
+                   projection_tolerance, order, coordinates ("absolute" or "joint"); the
+                   integrator is a name of odyn.integrators())
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"}, ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
@@ -50,7 +51,8 @@ TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forc
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf": 0.9,
                                      "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
 ANALYSIS_OPTIONAL = ("rtol", "atol", "max_step", "adaptive", "newton_rtol", "newton_atol",
-                     "constraint_tolerance", "max_iterations", "projection_tolerance", "order")
+                     "constraint_tolerance", "max_iterations", "projection_tolerance", "order",
+                     "coordinates")
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
@@ -165,6 +167,8 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                 if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < 1:
                     fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
                 out[key] = d[key]
+            elif key == "coordinates":
+                out[key] = check_choice(d[key], f"{where}.{key}", ["absolute", "joint"])
             elif key == "order":
                 if not isinstance(d[key], int) or isinstance(d[key], bool) or \
                         not 1 <= d[key] <= 6:

@@ -36,6 +36,7 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   s.t_end = get(d, "t_end", s.t_end);
   s.output_interval = get(d, "output_interval", s.output_interval);
   s.integrator = get(d, "integrator", s.integrator);
+  s.coordinates = get(d, "coordinates", s.coordinates);
   s.rtol = get(d, "rtol", s.rtol);
   s.atol = get(d, "atol", s.atol);
   s.max_step = get(d, "max_step", s.max_step);

@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -33,6 +34,11 @@ struct DynamicsSettings {
   /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
   /// control), "adams" (fixed step, order adams.order).
   std::string integrator = "generalized-alpha";
+  /// What dopri5 and dop853 step: "absolute" (every body's position and orientation, every
+  /// joint a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that
+  /// close loops as constraints; spatial models; see analysis/joint_coordinates.hpp). The
+  /// other integrators step absolute coordinates.
+  std::string coordinates = "absolute";
   /// Local error tolerances of the runs with error control, per component of (q, v).
   double rtol = 1e-6;
   double atol = 1e-6;
@@ -333,6 +339,24 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
 template <class Model, class Observer>
 RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
                     Observer&& observe) {
+  if (s.coordinates == "joint") {
+    if constexpr (std::is_same_v<typename Model::Space, Spatial>) {
+      if (s.integrator == "dopri5") return simulate_with<JointDormandPrince>(model, ws, s, observe);
+      if (s.integrator == "dop853")
+        return simulate_with<JointDormandPrince853>(model, ws, s, observe);
+      throw ModelError("dynamics", "joint coordinates run with dopri5 or dop853, not '" +
+                                       s.integrator +
+                                       "'; choose one of those, or coordinates "
+                                       "'absolute' for this integrator");
+    } else {
+      throw ModelError("dynamics",
+                       "joint coordinates are implemented for spatial models; planar models run "
+                       "in absolute coordinates (coordinates 'absolute')");
+    }
+  } else if (s.coordinates != "absolute") {
+    throw ModelError("dynamics",
+                     "unknown coordinates '" + s.coordinates + "'; choose 'absolute' or 'joint'");
+  }
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
     return simulate_with<GeneralizedAlpha>(model, ws, s, observe);
   if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);

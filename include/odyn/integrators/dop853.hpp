@@ -17,6 +17,7 @@
 
 #include <array>
 
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/integrators/explicit_runge_kutta.hpp"
 
 namespace odyn {
@@ -158,6 +159,12 @@ struct DormandPrince853Tableau {
 };
 
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
-using DormandPrince853 = ExplicitRungeKutta<DormandPrince853Tableau, Model, Solver>;
+using DormandPrince853 =
+    ExplicitRungeKutta<DormandPrince853Tableau, Model, AbsoluteCoordinates<Model, Solver>>;
+
+/// The same method on joint coordinates (see analysis/joint_coordinates.hpp).
+template <class Model>
+using JointDormandPrince853 =
+    ExplicitRungeKutta<DormandPrince853Tableau, Model, JointCoordinates<Model>>;
 
 }  // namespace odyn

@@ -11,6 +11,7 @@
 
 #include <array>
 
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/integrators/explicit_runge_kutta.hpp"
 
 namespace odyn {
@@ -52,6 +53,12 @@ struct DormandPrince5Tableau {
 };
 
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
-using DormandPrince = ExplicitRungeKutta<DormandPrince5Tableau, Model, Solver>;
+using DormandPrince =
+    ExplicitRungeKutta<DormandPrince5Tableau, Model, AbsoluteCoordinates<Model, Solver>>;
+
+/// The same method on joint coordinates (see analysis/joint_coordinates.hpp).
+template <class Model>
+using JointDormandPrince =
+    ExplicitRungeKutta<DormandPrince5Tableau, Model, JointCoordinates<Model>>;
 
 }  // namespace odyn

@@ -24,7 +24,7 @@
 #include <limits>
 #include <string>
 
-#include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/absolute_coordinates.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
@@ -67,7 +67,11 @@ concept ExplicitRungeKuttaMethod = requires {
   M::c[0] + M::a[0][0] + M::b[0] + M::error_weights[0] + M::dense[0][0];
 };
 
-template <ExplicitRungeKuttaMethod Method, class Model, class Solver = BlockSchurSaddlePoint<Model>>
+/// `Coordinates` is what the method steps: AbsoluteCoordinates (the bodies' own, every joint a
+/// constraint) or JointCoordinates (a spanning tree's joint coordinates, loop closures as
+/// constraints); both keep the workspace's frames up to date for elements and observers.
+template <ExplicitRungeKuttaMethod Method, class Model,
+          class Coordinates = AbsoluteCoordinates<Model>>
 class ExplicitRungeKutta {
  public:
   using Settings = DormandPrinceSettings;
@@ -83,7 +87,7 @@ class ExplicitRungeKutta {
         ws_(ws),
         settings_(settings),
         control_(control),
-        projection_(model),
+        coordinates_(model, ws),
         proposed_step_(std::min(control.first_step, control.max_step)) {
     if (!(control.rtol > 0.0) || !(control.atol > 0.0))
       throw ModelError(Method::name, "rtol and atol must be positive, got " +
@@ -91,9 +95,9 @@ class ExplicitRungeKutta {
     if (!(proposed_step_ > 0.0))
       throw ModelError(Method::name,
                        "the first step must be positive, got " + to_text(proposed_step_));
-    nq_total_ = model.num_coordinates();
-    nv_total_ = model.num_velocities();
-    m_ = model.num_equations();
+    nq_total_ = coordinates_.num_positions();
+    nv_total_ = coordinates_.num_velocities();
+    m_ = coordinates_.num_equations();
     size_ = nq_total_ + nv_total_;
     y_n_ = Eigen::VectorXd::Zero(size_);
     y_new_ = y_n_;
@@ -104,14 +108,15 @@ class ExplicitRungeKutta {
     for (auto& term : dense_terms_) term = y_n_;
     vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
     lambda_trial_ = Eigen::VectorXd::Zero(m_);
-    solver_.analyze(model);
+    vdot_n_ = vdot_trial_;
+    lambda_n_ = lambda_trial_;
     initialize();
   }
 
   /// Takes the workspace's state as the committed one (v' and lambda solved afresh).
   void initialize() {
     t_n_ = ws_.t;
-    y_n_ << ws_.q, ws_.v;
+    coordinates_.read_state(y_n_);
     restart();
   }
 
@@ -123,8 +128,8 @@ class ExplicitRungeKutta {
       throw SolverError(t_n_,
                         "the mass-constraint matrix is singular at the start of a step; "
                         "check for redundant or locked constraints");
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     ++statistics_.restarts;
   }
 
@@ -146,9 +151,9 @@ class ExplicitRungeKutta {
     if (!std::isfinite(error_)) return false;
     if (!project(t_n_ + h, y_new_, held_after_last_stage)) return false;
     // The trial state, kept for restore_trial() and, with k at it, for the dense output.
-    y_trial_ << ws_.q, ws_.v;
-    vdot_trial_ = ws_.vdot;
-    lambda_trial_ = ws_.lambda;
+    coordinates_.read_state(y_trial_);
+    vdot_trial_ = coordinates_.accelerations();
+    lambda_trial_ = coordinates_.multipliers();
     derivative_at_workspace(k_[new_point]);
     return true;
   }
@@ -166,14 +171,19 @@ class ExplicitRungeKutta {
   void interpolate_frames(double t) {
     if (!prepare_dense_output()) fail();
     dense_state(t);
-    load_state(t, y_dense_);
+    coordinates_.load(t, y_dense_);
   }
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
   void restore_trial() {
     load_solved_state(t_n_ + h_, y_trial_, vdot_trial_, lambda_trial_);
-    evaluate_forces(model_, ws_);
+    coordinates_.evaluate_forces();
   }
+
+  /// The workspace's blocks, v' and lambda for every element at the loaded state, when the
+  /// coordinates keep only some of them up to date while stepping (joint coordinates).
+  void refresh_blocks() requires requires(Coordinates& c) { c.complete_workspace(); }
+  { coordinates_.complete_workspace(); }
 
   /// Local error of the last attempt in units of the tolerance (accept when <= 1).
   double error_norm() const { return error_; }
@@ -220,8 +230,8 @@ class ExplicitRungeKutta {
     t_n_ += h_;
     y_n_ = y_trial_;
     k_[0] = k_[new_point];
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    vdot_n_ = vdot_trial_;
+    lambda_n_ = lambda_trial_;
     dense_ready_ = false;
     advance_states(model_, ws_);
     ++statistics_.steps;
@@ -287,55 +297,35 @@ class ExplicitRungeKutta {
   /// The workspace at a projected state (t, y) with its v' and lambda: frames and constraints.
   void load_solved_state(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& vdot,
                          const Eigen::VectorXd& lambda) {
-    ws_.t = t;
-    ws_.q = y.head(nq_total_);
-    ws_.v = y.tail(nv_total_);
-    ws_.vdot = vdot;
-    ws_.lambda = lambda;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.load(t, y);
+    coordinates_.restore_solution(vdot, lambda);
+    coordinates_.evaluate_constraints();
   }
 
-  /// The workspace at (t, y): q with unit quaternions, v, and the frames from them.
-  void load_state(double t, const Eigen::VectorXd& y) {
-    ws_.t = t;
-    ws_.q = y.head(nq_total_);
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = y.tail(nv_total_);
-    update_frames(model_, ws_);
-  }
-
-  /// f(t, y): the configuration rate and v' (index 1) at a stage; leaves v' and lambda in the
-  /// workspace. False if the saddle-point matrix is singular or a value is not finite.
+  /// f(t, y): the position rate and v' (index 1) at a stage; leaves v' and lambda in the
+  /// coordinates. False if the saddle-point matrix is singular or a value is not finite.
   bool derivative(double t, const Eigen::VectorXd& y, Eigen::VectorXd& k) {
     ++statistics_.residual_evaluations;
-    load_state(t, y);
-    evaluate_constraints(model_, ws_);
+    coordinates_.load(t, y);
+    coordinates_.evaluate_constraints();
     if (!accelerations()) return false;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
-          y.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
-    k.tail(nv_total_) = ws_.vdot;
+    coordinates_.position_rate(y, k.head(nq_total_));
+    k.tail(nv_total_) = coordinates_.accelerations();
     return all_finite(k);
   }
 
-  /// The derivative at the workspace's (consistent) state, whose v' is already solved.
+  /// The derivative at the trial state (loaded and consistent), whose v' is already solved.
   void derivative_at_workspace(Eigen::VectorXd& k) {
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      k.template segment<nq>(b * nq) = Model::Space::configuration_rate(
-          ws_.q.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
-    k.tail(nv_total_) = ws_.vdot;
+    coordinates_.position_rate(y_trial_, k.head(nq_total_));
+    k.tail(nv_total_) = coordinates_.accelerations();
   }
 
-  /// v' and lambda at the workspace's frames (constraints evaluated), factorizing afresh.
-  bool accelerations() {
-    return factorize() && projection_.solve_accelerations(model_, ws_, solver_);
-  }
+  /// v' and lambda at the loaded state (constraints evaluated), factorizing afresh.
+  bool accelerations() { return factorize() && coordinates_.solve_accelerations(); }
 
   bool factorize() {
     ++statistics_.factorizations;
-    return solver_.factorize(model_, ws_, IterationFactors{});
+    return coordinates_.factorize();
   }
 
   /// The extra stages and the terms of the continuous extension of the last attempt, computed
@@ -377,36 +367,31 @@ class ExplicitRungeKutta {
   /// whose v' and lambda then carry a relative error of the size of the correction but feed
   /// nothing back into the integration.
   bool project(double t, const Eigen::VectorXd& y, HeldMatrix held, bool output_point = false) {
-    load_state(t, y);
-    evaluate_constraints(model_, ws_);
+    coordinates_.load(t, y);
+    coordinates_.evaluate_constraints();
     bool matrix_at_positions = held == HeldMatrix::at_point;
     if (held == HeldMatrix::none) {
       if (!factorize()) return false;
       matrix_at_positions = true;
     }
-    for (int k = 0; m_ > 0 && !(ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance);
+    for (int k = 0; m_ > 0 && !(coordinates_.position_residual() <= settings_.projection_tolerance);
          ++k) {
       if (k == settings_.max_projection_iterations) return false;
-      projection_.correct_positions(model_, ws_, solver_);
+      coordinates_.correct_positions();
       ++statistics_.newton_iterations;
       matrix_at_positions = false;
     }
     if (!matrix_at_positions && !output_point && !factorize()) return false;
-    if (m_ > 0) {
-      projection_.velocity_residual(model_, ws_);
-      projection_.correct_velocities(model_, ws_, solver_);
-    }
+    if (m_ > 0) coordinates_.correct_velocities();
     // v' and lambda at the projected state: the same matrix, new right-hand side.
-    return projection_.solve_accelerations(model_, ws_, solver_) && all_finite(ws_.q) &&
-           all_finite(ws_.v);
+    return coordinates_.solve_accelerations() && coordinates_.state_finite();
   }
 
   const Model& model_;
   Workspace<Model>& ws_;
   Settings settings_;
   StepControl control_;
-  Solver solver_;
-  ConstraintProjection<Model> projection_;
+  Coordinates coordinates_;
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, size_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0, proposed_step_ = 1e-4;

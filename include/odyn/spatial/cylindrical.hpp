@@ -4,6 +4,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -11,6 +12,14 @@ class Cylindrical : public PairJoint {
  public:
   static constexpr int num_equations = 4;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 2;
+
+  /// As a tree joint: the child slides along the parent's axis and turns about it.
+  std::array<Screw, 2> tree_screws(const Input&, int parent_side) const {
+    const Triad& parent = frame(parent_side);
+    return {Screw{Screw::Kind::translation, parent.w, parent.point},
+            Screw{Screw::Kind::rotation, parent.w, parent.point}};
+  }
 
   void evaluate(const Input& in, BlocksOf<Cylindrical>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
@@ -32,5 +41,6 @@ class Cylindrical : public PairJoint {
   }
 };
 static_assert(Constraint<Cylindrical>);
+static_assert(TreeJoint<Cylindrical>);
 
 }  // namespace odyn::spatial

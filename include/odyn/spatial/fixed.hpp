@@ -3,6 +3,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -10,6 +11,10 @@ class Fixed : public PairJoint {
  public:
   static constexpr int num_equations = 6;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 0;
+
+  /// As a tree joint: the child is carried rigidly.
+  std::array<Screw, 0> tree_screws(const Input&, int) const { return {}; }
 
   void evaluate(const Input& in, BlocksOf<Fixed>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
@@ -31,5 +36,6 @@ class Fixed : public PairJoint {
   }
 };
 static_assert(Constraint<Fixed>);
+static_assert(TreeJoint<Fixed>);
 
 }  // namespace odyn::spatial

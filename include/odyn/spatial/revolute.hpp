@@ -3,6 +3,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -10,6 +11,13 @@ class Revolute : public PairJoint {
  public:
   static constexpr int num_equations = 5;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 1;
+
+  /// As a tree joint: the child turns about the parent's axis, through the parent's point.
+  std::array<Screw, 1> tree_screws(const Input&, int parent_side) const {
+    const Triad& parent = frame(parent_side);
+    return {Screw{Screw::Kind::rotation, parent.w, parent.point}};
+  }
 
   void evaluate(const Input& in, BlocksOf<Revolute>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
@@ -29,5 +37,6 @@ class Revolute : public PairJoint {
   }
 };
 static_assert(Constraint<Revolute>);
+static_assert(TreeJoint<Revolute>);
 
 }  // namespace odyn::spatial

@@ -4,6 +4,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -11,6 +12,13 @@ class Translational : public PairJoint {
  public:
   static constexpr int num_equations = 5;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 1;
+
+  /// As a tree joint: the child slides along the parent's axis.
+  std::array<Screw, 1> tree_screws(const Input&, int parent_side) const {
+    const Triad& parent = frame(parent_side);
+    return {Screw{Screw::Kind::translation, parent.w, parent.point}};
+  }
 
   void evaluate(const Input& in, BlocksOf<Translational>& out) const {
     const auto &a = in.body(0), &b = in.body(1);
@@ -34,5 +42,6 @@ class Translational : public PairJoint {
   }
 };
 static_assert(Constraint<Translational>);
+static_assert(TreeJoint<Translational>);
 
 }  // namespace odyn::spatial

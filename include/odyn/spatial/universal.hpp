@@ -6,6 +6,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -13,6 +14,17 @@ class Universal : public PairJoint {
  public:
   static constexpr int num_equations = 4;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 2;
+
+  /// As a tree joint: the child turns about the parent's axis, then about its own, both through
+  /// the parent's point (the child's axis given where it is at the start, in parent coordinates).
+  std::array<Screw, 2> tree_screws(const Input& in, int parent_side) const {
+    const Triad &parent = frame(parent_side), &child = frame(1 - parent_side);
+    const Spatial::Frame &p = in.body(parent_side), &c = in.body(1 - parent_side);
+    const Eigen::Vector3d child_axis = p.rotation.transpose() * c.direction(child.w);
+    return {Screw{Screw::Kind::rotation, parent.w, parent.point},
+            Screw{Screw::Kind::rotation, child_axis.normalized(), parent.point}};
+  }
 
   void bind(const Input& in) {
     PairJoint::bind(in);
@@ -39,5 +51,6 @@ class Universal : public PairJoint {
   }
 };
 static_assert(Constraint<Universal>);
+static_assert(TreeJoint<Universal>);
 
 }  // namespace odyn::spatial

@@ -1,0 +1,240 @@
+// Joint coordinates (analysis/joint_coordinates.hpp) against independent references: the engine
+// against its minimal-coordinate solution, an open chain of every tree-joint kind against the
+// same chain in absolute coordinates (a different formulation, converged) and its energy, the
+// steady top (a free root closed by a spherical joint) against the gyroscope equation; the
+// tree the method picks; and the models it refuses, by name.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <odyn/odyn.hpp>
+
+#include "bricard_model.hpp"
+#include "engine_model.hpp"
+#include "reference/engine_reference.hpp"
+#include "reference/steady_top.hpp"
+
+namespace test_joint_coordinates {
+
+namespace {
+
+namespace sp = odyn::spatial;
+using Eigen::Vector3d;
+
+odyn::DynamicsSettings joint_settings(const char* integrator, double tolerance) {
+  odyn::DynamicsSettings settings;
+  settings.integrator = integrator;
+  settings.coordinates = "joint";
+  settings.rtol = tolerance;
+  settings.atol = tolerance;
+  return settings;
+}
+
+/// Four bodies in an open chain: a bar on a revolute joint to the ground, a second bar on a
+/// universal joint to it, a sleeve on a cylindrical joint along the second bar and a block
+/// welded to the first bar; gravity only. Started tilted and moving, so that every joint works.
+using ChainModel = sp::Model<sp::Revolute, sp::Universal, sp::Cylindrical, sp::Fixed, sp::Gravity>;
+
+ChainModel chain() {
+  ChainModel model;
+  const Eigen::Quaterniond tilt(Eigen::AngleAxisd(0.4, Vector3d::UnitX()));
+  const Vector3d down = tilt * -Vector3d::UnitZ();  // along bar 1, from the pivot
+  const auto bar = [](const char* name, const Vector3d& centre, const Eigen::Quaterniond& turn) {
+    return sp::Body{.name = name,
+                    .mass = 1.0,
+                    .inertia = sp::Body::principal(0.09, 0.09, 0.005),
+                    .position = centre,
+                    .orientation = turn};
+  };
+  sp::Body upper = bar("upper", 0.5 * down, tilt);
+  upper.angular_velocity = {2.0, 0.0, 0.0};
+  const odyn::BodyId b1 = model.add_body(upper);
+  sp::Body lower = bar("lower", 1.5 * down, tilt);
+  lower.angular_velocity = {1.0, -1.5, 0.5};
+  const odyn::BodyId b2 = model.add_body(lower);
+  sp::Body sleeve{.name = "sleeve",
+                  .mass = 0.3,
+                  .inertia = sp::Body::principal(0.002, 0.002, 0.003),
+                  .position = 1.3 * down,
+                  .orientation = tilt};
+  sleeve.linear_velocity = 0.2 * down;
+  const odyn::BodyId b3 = model.add_body(sleeve);
+  const odyn::BodyId b4 = model.add_body({.name = "block",
+                                          .mass = 0.5,
+                                          .inertia = sp::Body::principal(0.01, 0.02, 0.03),
+                                          .position = 0.5 * down + tilt * Vector3d(0.2, 0, 0),
+                                          .orientation = tilt});
+  model.add(sp::Revolute("shoulder", odyn::ground, sp::JointFrame{{0, 0, 0}, Vector3d::UnitX()}, b1,
+                         sp::JointFrame{{0, 0, 0.5}, Vector3d::UnitX()}));
+  model.add(sp::Universal("elbow", b1, sp::JointFrame{{0, 0, -0.5}, Vector3d::UnitX()}, b2,
+                          sp::JointFrame{{0, 0, 0.5}, Vector3d::UnitY()}));
+  model.add(sp::Cylindrical("slide", b2, sp::JointFrame{{0, 0, 0}, Vector3d::UnitZ()}, b3,
+                            sp::JointFrame{{0, 0, 0}, Vector3d::UnitZ()}));
+  model.add(sp::Fixed("weld", b1, sp::JointFrame{{0.2, 0, 0}, Vector3d::UnitZ()}, b4,
+                      sp::JointFrame{{0, 0, 0}, Vector3d::UnitZ()}));
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  return model;
+}
+
+struct ChainRun {
+  std::vector<Eigen::VectorXd> positions;  // every body's centre and rotation, per output
+  double energy_drift = 0.0;
+  double phi = 0.0;
+};
+
+ChainRun run_chain(const odyn::DynamicsSettings& settings) {
+  ChainModel model = chain();
+  odyn::Workspace<ChainModel> ws(model);
+  odyn::DynamicsSettings s = settings;
+  s.t_end = 1.0;
+  s.output_interval = 0.1;
+  ChainRun out;
+  double energy0 = 0.0;
+  odyn::simulate(model, ws, s, [&](const auto& state) {
+    Eigen::VectorXd pose(12 * model.num_bodies());
+    for (int b = 1; b <= model.num_bodies(); ++b) {
+      pose.segment<3>(12 * (b - 1)) = state.frames[b].position;
+      pose.segment<9>(12 * (b - 1) + 3) = state.frames[b].rotation.reshaped();
+    }
+    out.positions.push_back(pose);
+    const double energy = odyn::kinetic_energy(model, state) + odyn::potential_energy(model, state);
+    if (out.positions.size() == 1) energy0 = energy;
+    out.energy_drift = std::max(out.energy_drift, std::abs(energy - energy0));
+    out.phi = std::max(out.phi, state.phi.cwiseAbs().maxCoeff());
+  });
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Joint coordinates: the engine's tree closes at the crank pin", "[joint]") {
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  const odyn::JointCoordinates<engine::Model> coordinates(e.model, ws);
+  // Kruskal keeps the joints with the most equations: 4 coordinates, 3 closure equations.
+  CHECK(coordinates.num_velocities() == 4);
+  CHECK(coordinates.num_positions() == 4);
+  CHECK(coordinates.num_equations() == 3);
+  CHECK(coordinates.loop_closures() == std::vector<std::string>{"crank pin"});
+  auto tree = coordinates.tree_joints();
+  std::sort(tree.begin(), tree.end());
+  CHECK(tree == std::vector<std::string>{"bearing", "cylinder", "piston pin"});
+}
+
+TEST_CASE("Joint coordinates: the engine against its minimal-coordinate solution",
+          "[joint][engine]") {
+  const auto reference = engine_reference::solve(1.0, 1e-3);
+  double peak = 0.0;
+  for (const auto& sample : reference) peak = std::max(peak, std::abs(sample.R_z));
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> ws(e.model);
+  std::size_t k = 0;
+  double z_error = 0.0, reaction_error = 0.0;
+  const auto summary =
+      odyn::simulate(e.model, ws, joint_settings("dop853", 1e-9), [&](const auto& state) {
+        const auto& sample = reference.at(k++);
+        z_error = std::max(z_error, std::abs(engine::piston_height(e, state) - sample.z_piston));
+        // The reaction jumps with the gas force: compare away from the two jumps per cycle.
+        const double phase = std::fmod(sample.theta, 4.0 * std::numbers::pi);
+        const bool near_jump = std::abs(phase - 2.0 * std::numbers::pi) < 0.05 ||
+                               std::abs(phase - 3.0 * std::numbers::pi) < 0.05;
+        if (!near_jump)
+          reaction_error = std::max(
+              reaction_error, std::abs(engine::bearing_force_z(e, state) - sample.R_z) / peak);
+      });
+  const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
+  INFO("theta error " << theta_error << " rad, z error " << z_error << " m, R_z error / peak "
+                      << reaction_error << ", steps " << summary.statistics.steps);
+  CHECK(k == reference.size());
+  // Measured: 2.5e-9 rad, 1.0e-10 m, 3.3e-9 of the peak (the reactions of tree joints come from
+  // the absolute equations at each output).
+  CHECK(theta_error < 1e-8);
+  CHECK(z_error < 1e-9);
+  CHECK(reaction_error < 2e-8);
+  CHECK(summary.statistics.events ==
+        static_cast<long>(std::floor(reference.back().theta / std::numbers::pi)));
+  // The tree joints hold by construction, the crank pin by projection.
+  CHECK(summary.max_position_residual < 1e-11);
+  CHECK(summary.max_velocity_residual < 1e-9);
+}
+
+TEST_CASE("Joint coordinates: an open chain of every tree-joint kind against absolute ones",
+          "[joint]") {
+  odyn::DynamicsSettings absolute;
+  absolute.integrator = "dop853";
+  absolute.rtol = absolute.atol = 1e-11;
+  const ChainRun reference = run_chain(absolute);
+  const ChainRun joint = run_chain(joint_settings("dop853", 1e-11));
+  const ChainRun joint5 = run_chain(joint_settings("dopri5", 1e-9));
+  REQUIRE(joint.positions.size() == reference.positions.size());
+  double difference = 0.0, difference5 = 0.0, motion = 0.0;
+  for (std::size_t k = 0; k < reference.positions.size(); ++k) {
+    difference =
+        std::max(difference, (joint.positions[k] - reference.positions[k]).cwiseAbs().maxCoeff());
+    difference5 =
+        std::max(difference5, (joint5.positions[k] - reference.positions[k]).cwiseAbs().maxCoeff());
+    motion =
+        std::max(motion, (reference.positions[k] - reference.positions[0]).cwiseAbs().maxCoeff());
+  }
+  INFO("largest difference from absolute coordinates: dop853 "
+       << difference << ", dopri5 " << difference5 << "; motion " << motion);
+  INFO("energy drift " << joint.energy_drift << " J; |Phi| " << joint.phi);
+  CHECK(motion > 0.5);  // every body really moved
+  // Measured: 8e-15 (both runs converged), 5e-10 for dopri5 at tolerance 1e-9.
+  CHECK(difference < 1e-10);
+  CHECK(difference5 < 1e-8);
+  // No loop: energy is what the integrator keeps (measured 1.6e-14 J), and every joint holds
+  // exactly.
+  CHECK(joint.energy_drift < 1e-10);
+  CHECK(joint.phi < 1e-12);
+}
+
+TEST_CASE("Joint coordinates: a free root closed by a spherical joint (the steady top)",
+          "[joint][pendulums]") {
+  const auto top = steady_top::run<odyn::JointDormandPrince853>(joint_settings("dop853", 1e-11));
+  INFO("tilt error " << top.tilt_error << ", precession " << top.azimuth << " vs "
+                     << top.precession_rate);
+  CHECK(top.tilt_error < 1e-8);
+  CHECK(top.azimuth == Approx(top.precession_rate).epsilon(1e-8));
+  CHECK(top.spin_error < 1e-8 * top.spin);
+  CHECK(top.unit_error < 1e-15);
+}
+
+TEST_CASE("Joint coordinates: redundant closures, planar models and other integrators refused",
+          "[joint][errors]") {
+  auto linkage = bricard::build();
+  odyn::Workspace<bricard::Model> ws(linkage.model);
+  const auto bricard_message = [&] {
+    try {
+      odyn::simulate(linkage.model, ws, joint_settings("dop853", 1e-8), [](const auto&) {});
+    } catch (const odyn::ModelError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  }();
+  INFO(bricard_message);
+  CHECK(bricard_message.find("redundant") != std::string::npos);
+  CHECK(bricard_message.find("absolute coordinates") != std::string::npos);
+
+  engine::planar::Engine planar = engine::planar::build();
+  odyn::Workspace<engine::planar::Model> planar_ws(planar.model);
+  CHECK_THROWS_WITH(
+      odyn::simulate(planar.model, planar_ws, joint_settings("dop853", 1e-8), [](const auto&) {}),
+      Catch::Contains("spatial models"));
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> engine_ws(e.model);
+  CHECK_THROWS_WITH(
+      odyn::simulate(e.model, engine_ws, joint_settings("bdf", 1e-8), [](const auto&) {}),
+      Catch::Contains("dopri5 or dop853"));
+  odyn::DynamicsSettings unknown = joint_settings("dop853", 1e-8);
+  unknown.coordinates = "relative";
+  CHECK_THROWS_WITH(odyn::simulate(e.model, engine_ws, unknown, [](const auto&) {}),
+                    Catch::Contains("unknown coordinates 'relative'"));
+}
+
+}  // namespace test_joint_coordinates
