@@ -3,7 +3,7 @@
 // `slider_crank_planar`): options, the CSV of the paper's outputs and the summary.
 //
 //   NAME [--h STEP] [--t-end T] [--dt-out DT] [--out FILE] [--integrator NAME] [--rho-inf R]
-//        [--order K] [--rtol R] [--atol A]
+//        [--order K] [--rtol R] [--atol A] [--coordinates absolute|joint]
 
 #include <cstdio>
 #include <cstdlib>
@@ -39,7 +39,8 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
         << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
            "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf|adams] [--rho-inf R]\n"
            "       [--order K (adams, 1 to 6)] [--rtol R] [--atol A]   (error control: --h is then "
-           "the first step)\n";
+           "the first step)\n"
+           "       [--coordinates absolute|joint]   (joint: dopri5 and dop853, spatial models)\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
   for (int i = 1; i < argc; ++i) {
@@ -63,6 +64,8 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
       out_path = value;
     else if (option == "--integrator")
       settings.integrator = value;
+    else if (option == "--coordinates")
+      settings.coordinates = value;
     else if (option == "--order")
       settings.adams.order = static_cast<int>(cli::number(program, "--order", value));
     else if (option == "--rho-inf")
@@ -100,8 +103,9 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
     std::printf("%s: %s, h = %g s, t_end = %g s -> %s (%ld rows)\n", program.c_str(),
                 settings.integrator.c_str(), settings.step, settings.t_end, out_path.c_str(),
                 summary.outputs);
-    std::printf("  %d coordinates, %d constraint equations\n", e.model.num_velocities(),
-                e.model.num_equations());
+    std::printf("  %d coordinates, %d constraint equations in absolute coordinates%s\n",
+                e.model.num_velocities(), e.model.num_equations(),
+                settings.coordinates == "joint" ? "; stepped in joint coordinates" : "");
     std::printf("  steps %ld, Newton iterations %ld (%.2f per step), factorizations %ld\n",
                 stats.steps, stats.newton_iterations,
                 stats.steps ? double(stats.newton_iterations) / double(stats.steps) : 0.0,

@@ -220,7 +220,8 @@ class JointCoordinates {
 
   /// Brings the whole workspace to the loaded state as an absolute-coordinate run leaves it:
   /// q and v, every element's blocks, v' and lambda of every joint (tree joints included, for
-  /// their reactions), from one solve of the absolute system.
+  /// their reactions). Reads the forces and theta'' of the last solve_accelerations, which
+  /// the integrator has made at this state.
   void complete_workspace() {
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       const Frame& frame = ws_.frames[b];
@@ -233,8 +234,6 @@ class JointCoordinates {
       ws_.v.template segment<3>(6 * (b - 1) + 3) = ws_.frames[b].angular_velocity;
     }
     odyn::evaluate_constraints(model_, ws_);
-    odyn::evaluate_forces(model_, ws_);
-    odyn::evaluate_gamma(model_, ws_);
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       auto vdot = ws_.vdot.template segment<6>(6 * (b - 1));
       vdot = bias_.segment<6>(6 * (b - 1));
