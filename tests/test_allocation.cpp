@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 #include "engine_model.hpp"
@@ -87,6 +88,27 @@ TEST_CASE("a BDF step allocates nothing, events and restarts included", "[worksp
   counting = false;
   CHECK(integrator.statistics().events >= 2);
   CHECK(allocations == 0);
+}
+
+TEST_CASE("a dop853 step allocates nothing, in absolute and in joint coordinates",
+          "[workspace][dop853][joint]") {
+  const auto check = [](auto integrator_type) {
+    using Integrator = typename decltype(integrator_type)::type;
+    engine::Engine e = engine::build();
+    odyn::Workspace<engine::Model> ws(e.model);
+    odyn::assemble(e.model, ws);
+    Integrator integrator(e.model, ws, {}, {.rtol = 1e-8, .atol = 1e-8, .first_step = 1e-5});
+    odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
+    allocations = 0;
+    counting = true;
+    odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+    if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
+    counting = false;
+    CHECK(integrator.statistics().events >= 2);
+    CHECK(allocations == 0);
+  };
+  check(std::type_identity<odyn::DormandPrince853<engine::Model>>{});
+  check(std::type_identity<odyn::JointDormandPrince853<engine::Model>>{});
 }
 
 }  // namespace test_allocation

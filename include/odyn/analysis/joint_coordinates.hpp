@@ -211,8 +211,9 @@ class JointCoordinates {
   void correct_velocities() {
     const Eigen::Index n = num_velocities();
     solution_.head(n).setZero();
-    solution_.tail(num_equations()).noalias() = -(kkt_.bottomLeftCorner(num_equations(), n) * v_);
-    solution_.tail(num_equations()) -= phi_t_;
+    auto residual = solution_.tail(num_equations());  // -(C theta' + Phi_t), in place
+    residual.noalias() = kkt_.bottomLeftCorner(num_equations(), n) * v_;
+    residual = -(residual + phi_t_);
     kkt_ldlt_.solve_in_place(solution_);
     v_ += solution_.head(n);
     update_kinematics();
