@@ -59,14 +59,17 @@ TEST_CASE("dopri5: the engine through its switches", "[dopri5][engine]") {
     std::size_t k = 0;
     double z_error = 0.0;
     const auto summary = odyn::simulate_with<odyn::DormandPrince>(
-        e.model, ws, dopri5(1e-10), [&](const auto& state) {
+        e.model, ws, dopri5(1e-11), [&](const auto& state) {
           z_error = std::max(
               z_error, std::abs(engine::piston_height(e, state) - reference.at(k++).z_piston));
         });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     INFO("theta error " << theta_error << " rad, z error " << z_error << " m, steps "
                         << summary.statistics.steps);
-    // Measured (spatial): 4.9e-9 rad.
+    // Measured: 6.1e-9 rad and 2.5e-10 m (spatial), 9.9e-9 rad and 4.1e-10 m (planar). The
+    // error estimate holds only the error along the constraints to the tolerance (see
+    // explicit_runge_kutta.hpp), so a tolerance buys less accuracy than when the error across
+    // them counted in full (4.9e-9 rad at 1e-10 then, 4.8e-8 rad now), in fewer steps.
     CHECK(theta_error < 2e-8);
     CHECK(z_error < 1e-9);
     CHECK(summary.statistics.events ==

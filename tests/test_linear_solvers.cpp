@@ -1,5 +1,6 @@
 // The linear algebra under every analysis: the envelope Cholesky of small Schur complements
-// against Eigen's dense LLT; the pivoted LU and the rank-revealing QR against systems built with
+// against Eigen's dense LLT; the saddle-point L D L^T of joint coordinates against systems built
+// with a known solution; the pivoted LU and the rank-revealing QR against systems built with
 // a known solution, rank and null space; the closed-form principal moments against a rotated
 // diagonal tensor; and both saddle-point solvers against the system they solve, checked through
 // its residual [M Phi_q^T; Phi_q 0] [x; y] - [f; g] with the model's own products (mass_times,
@@ -14,6 +15,7 @@
 #include "engine_model.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/rank_revealing_qr.hpp"
+#include "odyn/linalg/saddle_point_ldlt.hpp"
 #include "odyn/linalg/small_cholesky.hpp"
 #include "odyn/linalg/symmetric_eigenvalues.hpp"
 
@@ -180,6 +182,52 @@ void check_solves_engine(const odyn::IterationFactors& factors) {
     odyn::jacobian_times(e.model, ws, solution.head(n), bottom);
     CHECK((top - rhs.head(n)).norm() <= 1e-10 * rhs.norm() * (1.0 + solution.norm()));
     CHECK((bottom - rhs.tail(m)).norm() <= 1e-10 * rhs.norm() * (1.0 + solution.norm()));
+  }
+}
+
+TEST_CASE("Saddle-point L D L^T solves with a known solution at every size, unrolled or not",
+          "[linalg]") {
+  // Sizes up to max_unrolled_size take the unrolled kernels, larger ones the loops with bounds
+  // known at run time; both must give the solution the system was built from.
+  for (const Eigen::Index n : {1, 2, 3, 4, 7, 9, 14, 19}) {
+    for (const Eigen::Index m : {0, 1, 3, 5}) {
+      if (m > n) continue;
+      INFO("n = " << n << ", m = " << m);
+      const Eigen::MatrixXd g = scrambled(n, n, 0.7 + static_cast<double>(m));
+      const Eigen::MatrixXd a = g * g.transpose() + Eigen::MatrixXd::Identity(n, n);
+      const Eigen::MatrixXd b = scrambled(m, n, 1.9 + static_cast<double>(n));
+      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n + m, n + m);
+      k.topLeftCorner(n, n) = a;
+      k.bottomLeftCorner(m, n) = b;
+      k.topRightCorner(n, m) = b.transpose();
+      const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(n + m, -2.0, 1.5);
+      Eigen::VectorXd x = k * expected;
+      odyn::SaddlePointLdlt ldlt;
+      ldlt.resize(n, m);
+      REQUIRE(ldlt.compute(k));
+      ldlt.solve_in_place(x);
+      CHECK((x - expected).lpNorm<Eigen::Infinity>() < 1e-10);
+    }
+  }
+  // A singular A (a zero row and column) or repeated rows of B give a pivot of the wrong sign.
+  for (const Eigen::Index n : {4, 18}) {
+    INFO("n = " << n);
+    const Eigen::MatrixXd g = scrambled(n, n, 0.2);
+    Eigen::MatrixXd a = g * g.transpose() + Eigen::MatrixXd::Identity(n, n);
+    Eigen::MatrixXd b = scrambled(2, n, 0.4);
+    b.row(1) = b.row(0);
+    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(n + 2, n + 2);
+    k.topLeftCorner(n, n) = a;
+    k.bottomLeftCorner(2, n) = b;
+    odyn::SaddlePointLdlt ldlt;
+    ldlt.resize(n, 2);
+    CHECK_FALSE(ldlt.compute(k));
+    b.row(1) = scrambled(1, n, 0.9);
+    a.row(1).setZero();
+    a.col(1).setZero();
+    k.topLeftCorner(n, n) = a;
+    k.bottomLeftCorner(2, n) = b;
+    CHECK_FALSE(ldlt.compute(k));
   }
 }
 

@@ -22,7 +22,10 @@ class AbsoluteCoordinates {
   static constexpr const char* name = "absolute";
 
   AbsoluteCoordinates(const Model& model, Workspace<Model>& ws)
-      : model_(model), ws_(ws), projection_(model) {
+      : model_(model),
+        ws_(ws),
+        projection_(model),
+        increment_(Eigen::VectorXd::Zero(model.num_velocities())) {
     solver_.analyze(model);
   }
 
@@ -73,6 +76,24 @@ class AbsoluteCoordinates {
   }
   /// One (chord) correction towards Phi = 0, least distance in the mass metric.
   void correct_positions() { projection_.correct_positions(model_, ws_, solver_); }
+  /// The part of a local error estimate e = (e_q, e_v) that outlives the projection ending the
+  /// step: the corrections move along M^-1 Phi_q^T and remove what Phi_q measures, so to first
+  /// order only e - M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi_q e is kept, for each part, with the
+  /// matrix factorized last (at a stage within the step, near its end). A quaternion's error
+  /// is taken as a turn, its change of length dropped (load() normalizes).
+  void keep_tangential(Eigen::Ref<Eigen::VectorXd> error) {
+    if (num_equations() == 0) return;
+    constexpr int nq = Model::nq, nv = Model::nv;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      increment_.template segment<nv>(b * nv) = Model::Space::increment_of(
+          ws_.q.template segment<nq>(b * nq), error.template segment<nq>(b * nq));
+    projection_.remove_normal_part(model_, ws_, solver_, increment_);
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      error.template segment<nq>(b * nq) = Model::Space::configuration_rate(
+          ws_.q.template segment<nq>(b * nq), increment_.template segment<nv>(b * nv));
+    projection_.remove_normal_part(model_, ws_, solver_, error.tail(num_velocities()));
+  }
+
   /// Removes Phi_q v + Phi_t, least change in the mass metric.
   void correct_velocities() {
     projection_.velocity_residual(model_, ws_);
@@ -84,6 +105,7 @@ class AbsoluteCoordinates {
   Workspace<Model>& ws_;
   Solver solver_;
   ConstraintProjection<Model> projection_;
+  Eigen::VectorXd increment_;  // a position error in velocity coordinates
 };
 
 }  // namespace odyn

@@ -67,6 +67,18 @@ class ConstraintProjection {
     return velocity_residual_;
   }
 
+  /// x minus the part of it that Phi_q measures, along M^-1 Phi_q^T (the direction in which
+  /// the corrections move): [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi_q x], x += dx.
+  template <class Solver>
+  void remove_normal_part(const Model& model, const Workspace<Model>& ws, Solver& solver,
+                          Eigen::Ref<Eigen::VectorXd> x) {
+    rhs_.head(nv_total_).setZero();
+    jacobian_times(model, ws, x, rhs_.tail(m_));
+    rhs_.tail(m_) = -rhs_.tail(m_);
+    solver.solve(rhs_, solution_);
+    x += solution_.head(nv_total_);
+  }
+
   /// Removes the velocity residual that velocity_residual() computed last:
   /// [M Phi_q^T; Phi_q 0] [dv; mu] = [0; -(Phi_q v + Phi_t)], then the frames at the new v.
   template <class Solver>

@@ -33,10 +33,10 @@
 // Limits: spatial models; loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <algorithm>
 #include <array>
 #include <numeric>
@@ -207,6 +207,32 @@ class JointCoordinates {
     evaluate_constraints();
   }
 
+  /// The part of a local error estimate e = (e_q, e_v) that outlives the projection ending the
+  /// step. correct_positions and correct_velocities move along A^-1 C^T (A = J^T M J) and remove
+  /// what C measures, so to first order only e - A^-1 C^T (C A^-1 C^T)^-1 C e is kept, for each
+  /// part; the matrix is the one factorized last (at a stage within the step, near its end). A
+  /// free root's quaternion error is taken as a turn, its change of length dropped (load()
+  /// normalizes).
+  void keep_tangential(Eigen::Ref<Eigen::VectorXd> error) {
+    if (num_equations() == 0) return;
+    for (const TreeBody& node : tree_) {
+      if (node.free)
+        increment_.segment<Spatial::nv>(node.v_offset) = Spatial::increment_of(
+            q_.segment<Spatial::nq>(node.q_offset), error.segment<Spatial::nq>(node.q_offset));
+      else
+        increment_.segment(node.v_offset, node.dof()) = error.segment(node.q_offset, node.dof());
+    }
+    remove_normal_part(increment_);
+    for (const TreeBody& node : tree_) {
+      if (node.free)
+        error.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
+            q_.segment<Spatial::nq>(node.q_offset), increment_.segment<Spatial::nv>(node.v_offset));
+      else
+        error.segment(node.q_offset, node.dof()) = increment_.segment(node.v_offset, node.dof());
+    }
+    remove_normal_part(error.tail(num_velocities()));
+  }
+
   /// Removes C theta' + Phi_t, least change in J^T M J.
   void correct_velocities() {
     const Eigen::Index n = num_velocities();
@@ -216,7 +242,7 @@ class JointCoordinates {
     residual = -(residual + phi_t_);
     kkt_ldlt_.solve_in_place(solution_);
     v_ += solution_.head(n);
-    update_kinematics();
+    update_velocities();
   }
 
   /// Brings the whole workspace to the loaded state as an absolute-coordinate run leaves it:
@@ -234,7 +260,6 @@ class JointCoordinates {
       ws_.v.template segment<3>(6 * (b - 1)) = ws_.frames[b].linear_velocity;
       ws_.v.template segment<3>(6 * (b - 1) + 3) = ws_.frames[b].angular_velocity;
     }
-    odyn::evaluate_constraints(model_, ws_);
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       auto vdot = ws_.vdot.template segment<6>(6 * (b - 1));
       vdot = bias_.segment<6>(6 * (b - 1));
@@ -255,6 +280,8 @@ class JointCoordinates {
     // Then up the tree: what the body's own equation leaves, Q - M v' - (the forces known so
     // far), is its tree joint's force B^T lambda; lambda follows from B B^T lambda = B (that),
     // exact as the equations are consistent, and its force on the parent joins the parent's.
+    // The tree joints' blocks are evaluated here (the closures' are current from
+    // evaluate_constraints(), which every state the integrator loads goes through).
     for (auto node = tree_.rbegin(); node != tree_.rend(); ++node) {
       if (node->free) continue;
       const int b = node->body;
@@ -263,15 +290,28 @@ class JointCoordinates {
           ws_.force.template segment<6>(6 * (b - 1)) -
           Spatial::mass_times(body.mass, body.inertia, ws_.vdot.template segment<6>(6 * (b - 1))) -
           constraint_force_.segment<6>(6 * (b - 1));
-      model_.for_each_pool([&]<class E>(const std::vector<E>&, auto type) {
+      model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
         if constexpr (spatial::TreeJoint<E>) {
           if (type != node->joint_type) return;
           constexpr int m = E::num_equations;
-          const auto& blocks = std::get<type>(ws_.blocks)[node->joint_index];
+          const E& joint = pool[node->joint_index];
+          auto& blocks = std::get<type>(ws_.blocks)[node->joint_index];
+          joint.evaluate(detail::input_of(joint, ws_.frames, ws_.t), blocks);
+          const int row = model_.template rows<E>()[node->joint_index];
+          ws_.phi.template segment<m>(row) = blocks.phi;
+          ws_.phi_t.template segment<m>(row) = blocks.phi_t;
+          // B has full row rank (a joint's equations are independent): B B^T is positive
+          // definite, and its unrolled L D L^T costs a fraction of Eigen's LLT at this size.
           const auto& on_child = blocks.jacobian[node->child_side];
           const Eigen::Matrix<double, m, m> normal = on_child * on_child.transpose();
-          const Eigen::Matrix<double, m, 1> lambda = normal.ldlt().solve(on_child * left);
-          ws_.lambda.template segment<m>(model_.template rows<E>()[node->joint_index]) = lambda;
+          Eigen::Matrix<double, m, 1> lambda = on_child * left;
+          Eigen::Matrix<double, m, m> factor;
+          Eigen::Matrix<double, m, 1> inverse_diagonal;
+          if (detail::ldlt_factor<m>(m, m, normal.data(), factor.data(), inverse_diagonal.data()))
+            detail::ldlt_solve<m>(m, factor.data(), inverse_diagonal.data(), lambda.data());
+          else
+            lambda = normal.completeOrthogonalDecomposition().solve(on_child * left);
+          ws_.lambda.template segment<m>(row) = lambda;
           if (node->parent != 0)
             constraint_force_.segment<6>(6 * (node->parent - 1)).noalias() +=
                 blocks.jacobian[1 - node->child_side].transpose() * lambda;
@@ -447,6 +487,7 @@ class JointCoordinates {
     qdd_.setZero(n);
     kkt_.setZero(n + m, n + m);
     solution_.setZero(n + m);
+    increment_.setZero(n);
     kkt_ldlt_.resize(n, m);
   }
 
@@ -494,6 +535,15 @@ class JointCoordinates {
                            std::to_string(lu.rank()) + " of " + std::to_string(num_equations()) +
                            "); use absolute coordinates, which run with redundant constraints");
     }
+  }
+
+  /// x - A^-1 C^T (C A^-1 C^T)^-1 C x, a rate-space vector with no component that C measures.
+  void remove_normal_part(Eigen::Ref<Eigen::VectorXd> x) {
+    const Eigen::Index n = num_velocities();
+    solution_.head(n).setZero();
+    solution_.tail(num_equations()).noalias() = -(kkt_.bottomLeftCorner(num_equations(), n) * x);
+    kkt_ldlt_.solve_in_place(solution_);
+    x += solution_.head(n);
   }
 
   int num_columns(int body) const { return first_column_[body + 1] - first_column_[body]; }
@@ -566,20 +616,57 @@ class JointCoordinates {
         frame.angular_velocity = frame.rotation.transpose() * twist.head<3>();
         frame.linear_velocity = twist.tail<3>() + twist.head<3>().cross(frame.position);
       }
-      twist_[b] = twist;
-      spatial_bias_[b] = bias;
-      // v_centre = v_O + omega x x and omega_body = R^T omega, column by column; the bias
-      // likewise, with the centre's acceleration v_O' + omega' x x + omega x v_centre.
+      // v_centre = v_O + omega x x and omega_body = R^T omega, column by column.
       for (int j = 0; j < num_columns(b); ++j) {
         const Vector6& xi = spatial_column(b, j);
         Vector6& column = body_columns_[first_column_[b] + j];
         column.head<3>() = xi.tail<3>() + xi.head<3>().cross(frame.position);
         column.tail<3>().noalias() = frame.rotation.transpose() * xi.head<3>();
       }
-      bias_.segment<3>(6 * (b - 1)) = bias.tail<3>() + bias.head<3>().cross(frame.position) +
-                                      twist.head<3>().cross(frame.linear_velocity);
-      bias_.segment<3>(6 * (b - 1) + 3) = frame.rotation.transpose() * bias.head<3>();
+      store_motion(b, frame, twist, bias);
     }
+  }
+
+  /// After a change of the rates alone (correct_velocities): twists, bias accelerations and
+  /// the frames' velocities again, with the frames and screws of the last update_kinematics.
+  /// The same operations in the same order as there, so the same numbers.
+  void update_velocities() {
+    for (const TreeBody& node : tree_) {
+      const int b = node.body;
+      Frame& frame = ws_.frames[b];
+      Vector6 twist, bias;
+      if (node.free) {
+        frame.linear_velocity = v_.segment<3>(node.v_offset);
+        frame.angular_velocity = v_.segment<3>(node.v_offset + 3);
+        const Eigen::Vector3d omega = frame.rotation * frame.angular_velocity;
+        twist << omega, frame.linear_velocity + frame.position.cross(omega);
+        bias << Eigen::Vector3d::Zero(), frame.linear_velocity.cross(omega);
+      } else {
+        twist = twist_[node.parent];
+        bias = spatial_bias_[node.parent];
+        const int inherited = num_columns(node.parent);
+        for (int i = 0; i < static_cast<int>(node.screws.size()); ++i) {
+          const Vector6& xi = spatial_column(b, inherited + i);
+          const double rate = v_[node.v_offset + i];
+          bias += cross_motion(twist, xi) * rate;
+          twist += xi * rate;
+        }
+        frame.angular_velocity = frame.rotation.transpose() * twist.head<3>();
+        frame.linear_velocity = twist.tail<3>() + twist.head<3>().cross(frame.position);
+      }
+      store_motion(b, frame, twist, bias);
+    }
+  }
+
+  /// Keeps body b's twist and bias acceleration (global, at the origin), and its bias c in its
+  /// own velocity coordinates: the centre's acceleration v_O' + omega' x x + omega x v_centre,
+  /// and R^T omega'.
+  void store_motion(int b, const Frame& frame, const Vector6& twist, const Vector6& bias) {
+    twist_[b] = twist;
+    spatial_bias_[b] = bias;
+    bias_.segment<3>(6 * (b - 1)) = bias.tail<3>() + bias.head<3>().cross(frame.position) +
+                                    twist.head<3>().cross(frame.linear_velocity);
+    bias_.segment<3>(6 * (b - 1) + 3) = frame.rotation.transpose() * bias.head<3>();
   }
 
   const Model& model_;
@@ -602,6 +689,7 @@ class JointCoordinates {
   Eigen::MatrixXd kkt_;               // (n + m) [J^T M J  C^T; C  0], lower triangle
   SaddlePointLdlt kkt_ldlt_;
   Eigen::VectorXd solution_;      // (n + m) right-hand side, then solution
+  Eigen::VectorXd increment_;     // (n) a position error in rate coordinates
   Eigen::VectorXd qdd_, lambda_;  // (n), (m) of the last solve_accelerations
 };
 

@@ -124,6 +124,12 @@ struct Planar {
     return v;
   }
 
+  /// The velocity-space increment whose configuration_rate is dq: dq itself.
+  static Velocity increment_of(const Eigen::Ref<const Configuration>&,
+                               const Eigen::Ref<const Configuration>& dq) {
+    return dq;
+  }
+
   /// Magnitudes of the coordinates that the velocity components move, for relative error
   /// tolerances.
   static Velocity coordinate_scale(const Eigen::Ref<const Configuration>& q) {

@@ -133,6 +133,18 @@ struct Spatial {
     return rate;
   }
 
+  /// The velocity-space increment whose configuration_rate at q is dq, the inverse of that
+  /// linear map on its range: dq's part along the quaternion itself (a change of its length,
+  /// which normalize() removes) is dropped.
+  static Velocity increment_of(const Eigen::Ref<const Configuration>& q,
+                               const Eigen::Ref<const Configuration>& dq) {
+    const Eigen::Quaterniond turn =
+        orientation(q).conjugate() * Eigen::Quaterniond(dq[3], dq[4], dq[5], dq[6]);
+    Velocity increment;
+    increment << dq.head<3>(), 2.0 * turn.vec();
+    return increment;
+  }
+
   /// Magnitudes of the coordinates that the velocity components move, for relative error
   /// tolerances: the centre of mass's, and 1 for the rotation (radians).
   static Velocity coordinate_scale(const Eigen::Ref<const Configuration>& q) {

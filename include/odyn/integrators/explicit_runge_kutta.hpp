@@ -164,7 +164,7 @@ class ExplicitRungeKutta {
   bool interpolate(double t) {
     if (!prepare_dense_output()) return false;
     dense_state(t);
-    return project(t, y_dense_, HeldMatrix::none, true);
+    return project(t, y_dense_, HeldMatrix::none);
   }
 
   /// The interpolated positions and velocities at t and the frames from them, unprojected.
@@ -259,6 +259,7 @@ class ExplicitRungeKutta {
 
  private:
   static constexpr int s = Method::stages;
+  static constexpr double normal_error_allowance = 30.0;
   static constexpr int new_point = s;  // k_[s]: f at the projected end of the last attempt
   static constexpr int num_derivatives = s + 1 + Method::extra_stages;
   // y_{n+1} - y_n, h k_0 - (y_{n+1} - y_n), the Hermite term, then the method's dense rows.
@@ -288,10 +289,23 @@ class ExplicitRungeKutta {
       if (weights[j] != 0.0) out.noalias() += (h * weights[j]) * k_[j];
   }
 
-  /// The local error of the step to y_new_ in units of the tolerance.
+  /// The local error of the step to y_new_ in units of the tolerance. The projection that ends
+  /// the step removes the error's part across the constraints (in the mass metric), so only
+  /// the part along them is a local error of the projected solution, held to the tolerance.
+  /// The part across is still bounded, by normal_error_allowance tolerances: the projection
+  /// then starts close by, and the continuous extension between the step's ends stays near
+  /// the constraints (a mechanism with no degree of freedom left has no part along them).
   double estimate_error(double h) {
     combine(stage_, h, Method::error_weights, s);
-    return weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
+    const auto norm = [&] {
+      return weighted_rms_norm(stage_, y_n_, y_new_, control_.rtol, control_.atol);
+    };
+    if constexpr (requires { coordinates_.keep_tangential(stage_); }) {
+      const double whole = norm();
+      coordinates_.keep_tangential(stage_);
+      return std::max(norm(), whole / normal_error_allowance);
+    }
+    return norm();
   }
 
   /// The workspace at a projected state (t, y) with its v' and lambda: frames and constraints.
@@ -362,11 +376,9 @@ class ExplicitRungeKutta {
   /// Moves y onto Phi = 0 and Phi_q v + Phi_t = 0, the least distance in the mass metric, and
   /// solves v' and lambda there. The workspace then holds the projected state at t.
   /// The positions take chord iterations with the matrix `held` (or factorized at y): the
-  /// corrections are of the size of the local error. v' and lambda start the next step, so
-  /// they are solved with the matrix at the projected positions, except at an `output_point`,
-  /// whose v' and lambda then carry a relative error of the size of the correction but feed
-  /// nothing back into the integration.
-  bool project(double t, const Eigen::VectorXd& y, HeldMatrix held, bool output_point = false) {
+  /// corrections are of the size of the local error. v' and lambda are solved with the matrix
+  /// at the projected positions (factorized again after a correction).
+  bool project(double t, const Eigen::VectorXd& y, HeldMatrix held) {
     coordinates_.load(t, y);
     coordinates_.evaluate_constraints();
     bool matrix_at_positions = held == HeldMatrix::at_point;
@@ -381,7 +393,7 @@ class ExplicitRungeKutta {
       ++statistics_.newton_iterations;
       matrix_at_positions = false;
     }
-    if (!matrix_at_positions && !output_point && !factorize()) return false;
+    if (!matrix_at_positions && !factorize()) return false;
     if (m_ > 0) coordinates_.correct_velocities();
     // v' and lambda at the projected state: the same matrix, new right-hand side.
     return coordinates_.solve_accelerations() && coordinates_.state_finite();
