@@ -157,11 +157,14 @@ class JointCoordinates {
     force.setZero();
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       const auto& body = model_.body(BodyId{b});
-      const auto c = bias_.segment<6>(6 * (b - 1));
-      Vector6 net = ws_.force.template segment<6>(6 * (b - 1));
-      net.head<3>() -= body.mass * c.head<3>();
-      net.tail<3>() -= body.inertia * c.tail<3>();
-      for (int j = 0; j < num_columns(b); ++j) force[columns_[b][j]] += body_column(b, j).dot(net);
+      // Q - M c, by 3-vectors (see evaluate_forces).
+      const Eigen::Vector3d linear =
+          ws_.force.template segment<3>(6 * (b - 1)) - body.mass * bias_.segment<3>(6 * (b - 1));
+      const Eigen::Vector3d angular = ws_.force.template segment<3>(6 * (b - 1) + 3) -
+                                      body.inertia * bias_.segment<3>(6 * (b - 1) + 3);
+      for (int j = 0; j < num_columns(b); ++j)
+        force[columns_[b][j]] += body_column(b, j).template head<3>().dot(linear) +
+                                 body_column(b, j).template tail<3>().dot(angular);
     }
     for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int) {
       auto g = solution_.segment<E::num_equations>(n + row);
@@ -551,12 +554,23 @@ class JointCoordinates {
   Vector6& spatial_column(int b, int j) { return spatial_columns_[first_column_[b] + j]; }
   const Vector6& body_column(int b, int j) const { return body_columns_[first_column_[b] + j]; }
 
-  /// (omega, v) x (omega', v') of twists: the rate of a screw carried by a moving frame.
-  static Vector6 cross_motion(const Vector6& x, const Vector6& y) {
-    Vector6 out;
-    out.head<3>() = x.head<3>().cross(y.head<3>());
-    out.tail<3>() = x.head<3>().cross(y.tail<3>()) + x.tail<3>().cross(y.head<3>());
-    return out;
+  /// to = from, by 3-vectors: from's halves were just stored a number at a time, and a copy
+  /// in pairs would wait on them (see evaluate_forces).
+  static void copy_halves(const Vector6& from, Vector6& to) {
+    to.head<3>() = from.head<3>();
+    to.tail<3>() = from.tail<3>();
+  }
+
+  /// A joint's motion xi at its rate, added to the twist carried so far, and the bias that the
+  /// carrying adds: (twist x xi) rate, with (omega, v) x (omega', v') = (omega x omega',
+  /// omega x v' + v x omega'). By 3-vectors: the cross products are stored a number at a time,
+  /// and 6-vector arithmetic on them would read pairs (see evaluate_forces).
+  static void add_motion(const Vector6& xi, double rate, Vector6& twist, Vector6& bias) {
+    const Eigen::Vector3d omega = twist.head<3>(), velocity = twist.tail<3>();
+    bias.head<3>() += omega.cross(xi.head<3>()) * rate;
+    bias.tail<3>() += (omega.cross(xi.tail<3>()) + velocity.cross(xi.head<3>())) * rate;
+    twist.head<3>() += xi.head<3>() * rate;
+    twist.tail<3>() += xi.tail<3>() * rate;
   }
 
   /// Down the tree: frames, spatial Jacobians, twists and bias accelerations; then J and c in
@@ -581,8 +595,8 @@ class JointCoordinates {
         const Frame& parent = ws_.frames[node.parent];
         const int inherited = num_columns(node.parent);
         for (int j = 0; j < inherited; ++j) spatial_column(b, j) = spatial_column(node.parent, j);
-        twist = twist_[node.parent];
-        bias = spatial_bias_[node.parent];
+        copy_halves(twist_[node.parent], twist);
+        copy_halves(spatial_bias_[node.parent], bias);
         // The frame the motions so far carry: its rotation and where the parent's origin went.
         Eigen::Matrix3d rotation = parent.rotation;
         Eigen::Vector3d origin = parent.position;
@@ -607,9 +621,8 @@ class JointCoordinates {
             xi << Eigen::Vector3d::Zero(), axis;
             origin += angle * axis;
           }
-          bias += cross_motion(twist, xi) * rate;
-          twist += xi * rate;
-          spatial_column(b, inherited + i) = xi;
+          add_motion(xi, rate, twist, bias);
+          copy_halves(xi, spatial_column(b, inherited + i));
         }
         frame.rotation = rotation * node.rotation0;
         frame.position = origin + rotation * node.position0;
@@ -642,14 +655,13 @@ class JointCoordinates {
         twist << omega, frame.linear_velocity + frame.position.cross(omega);
         bias << Eigen::Vector3d::Zero(), frame.linear_velocity.cross(omega);
       } else {
-        twist = twist_[node.parent];
-        bias = spatial_bias_[node.parent];
+        copy_halves(twist_[node.parent], twist);
+        copy_halves(spatial_bias_[node.parent], bias);
         const int inherited = num_columns(node.parent);
         for (int i = 0; i < static_cast<int>(node.screws.size()); ++i) {
           const Vector6& xi = spatial_column(b, inherited + i);
           const double rate = v_[node.v_offset + i];
-          bias += cross_motion(twist, xi) * rate;
-          twist += xi * rate;
+          add_motion(xi, rate, twist, bias);
         }
         frame.angular_velocity = frame.rotation.transpose() * twist.head<3>();
         frame.linear_velocity = twist.tail<3>() + twist.head<3>().cross(frame.position);
@@ -662,8 +674,8 @@ class JointCoordinates {
   /// own velocity coordinates: the centre's acceleration v_O' + omega' x x + omega x v_centre,
   /// and R^T omega'.
   void store_motion(int b, const Frame& frame, const Vector6& twist, const Vector6& bias) {
-    twist_[b] = twist;
-    spatial_bias_[b] = bias;
+    copy_halves(twist, twist_[b]);
+    copy_halves(bias, spatial_bias_[b]);
     bias_.segment<3>(6 * (b - 1)) = bias.tail<3>() + bias.head<3>().cross(frame.position) +
                                     twist.head<3>().cross(frame.linear_velocity);
     bias_.segment<3>(6 * (b - 1) + 3) = frame.rotation.transpose() * bias.head<3>();
