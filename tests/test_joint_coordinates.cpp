@@ -152,7 +152,7 @@ TEST_CASE("Joint coordinates: the engine against its minimal-coordinate solution
   INFO("theta error " << theta_error << " rad, z error " << z_error << " m, R_z error / peak "
                       << reaction_error << ", steps " << summary.statistics.steps);
   CHECK(k == reference.size());
-  // Measured: 2.5e-9 rad, 1.0e-10 m, 3.3e-9 of the peak (the reactions of tree joints come from
+  // Measured: 3.5e-10 rad, 1.4e-11 m, 3.7e-10 of the peak (the reactions of tree joints come from
   // the absolute equations at each output).
   CHECK(theta_error < 1e-8);
   CHECK(z_error < 1e-9);
@@ -186,10 +186,10 @@ TEST_CASE("Joint coordinates: an open chain of every tree-joint kind against abs
        << difference << ", dopri5 " << difference5 << "; motion " << motion);
   INFO("energy drift " << joint.energy_drift << " J; |Phi| " << joint.phi);
   CHECK(motion > 0.5);  // every body really moved
-  // Measured: 8e-15 (both runs converged), 5e-10 for dopri5 at tolerance 1e-9.
+  // Measured: 1.2e-14 (both runs converged), 5.1e-10 for dopri5 at tolerance 1e-9.
   CHECK(difference < 1e-10);
   CHECK(difference5 < 1e-8);
-  // No loop: energy is what the integrator keeps (measured 1.6e-14 J), and every joint holds
+  // No loop: energy is what the integrator keeps (measured 2.5e-14 J), and every joint holds
   // exactly.
   CHECK(joint.energy_drift < 1e-10);
   CHECK(joint.phi < 1e-12);

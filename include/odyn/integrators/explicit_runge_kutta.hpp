@@ -10,7 +10,9 @@
 // positions and velocities drift off Phi = 0 and Phi_q v + Phi_t = 0 by the local error; after
 // each step both are projected back in the mass metric (the nearest consistent state), which
 // keeps the order and stops the drift. One solve of the saddle-point system per stage, no
-// Newton iteration on the dynamics: cheap per step when the problem is not stiff.
+// Newton iteration on the dynamics: cheap per step when the problem is not stiff. Since the
+// projection removes the local error's part across the constraints, the error estimate holds
+// the part along them to the tolerance and bounds the part across (see estimate_error).
 //
 // Step control as in Hairer, Norsett & Wanner, "Solving Ordinary Differential Equations I",
 // Sect. II.4; continuous extensions as in Sect. II.6.
