@@ -544,7 +544,9 @@ class JointCoordinates {
   void remove_normal_part(Eigen::Ref<Eigen::VectorXd> x) {
     const Eigen::Index n = num_velocities();
     solution_.head(n).setZero();
-    solution_.tail(num_equations()).noalias() = -(kkt_.bottomLeftCorner(num_equations(), n) * x);
+    auto measured = solution_.tail(num_equations());  // -C x, in place (no temporary)
+    measured.noalias() = kkt_.bottomLeftCorner(num_equations(), n) * x;
+    measured = -measured;
     kkt_ldlt_.solve_in_place(solution_);
     x += solution_.head(n);
   }
