@@ -98,13 +98,7 @@ class JointCoordinates {
   /// The coordinates' rate for the rates loaded last, at the positions held in y: a joint
   /// coordinate moves with its rate, a free root's quaternion as in Spatial.
   void position_rate(const Eigen::VectorXd& y, Eigen::Ref<Eigen::VectorXd> rate) const {
-    for (const TreeBody& node : tree_) {
-      if (node.free)
-        rate.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
-            y.segment<Spatial::nq>(node.q_offset), v_.segment<Spatial::nv>(node.v_offset));
-      else
-        rate.segment(node.q_offset, node.dof()) = v_.segment(node.v_offset, node.dof());
-    }
+    configuration_change(y, v_, rate);
   }
 
   /// The closures' Phi and blocks, and C = Phi_q J (into the saddle-point matrix's rows n..).
@@ -226,13 +220,7 @@ class JointCoordinates {
         increment_.segment(node.v_offset, node.dof()) = error.segment(node.q_offset, node.dof());
     }
     remove_normal_part(increment_);
-    for (const TreeBody& node : tree_) {
-      if (node.free)
-        error.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
-            q_.segment<Spatial::nq>(node.q_offset), increment_.segment<Spatial::nv>(node.v_offset));
-      else
-        error.segment(node.q_offset, node.dof()) = increment_.segment(node.v_offset, node.dof());
-    }
+    configuration_change(q_, increment_, error);
     remove_normal_part(error.tail(num_velocities()));
   }
 
@@ -537,6 +525,20 @@ class JointCoordinates {
                        "the loop-closure equations of " + names + " are redundant (rank " +
                            std::to_string(lu.rank()) + " of " + std::to_string(num_equations()) +
                            "); use absolute coordinates, which run with redundant constraints");
+    }
+  }
+
+  /// The change of the coordinates (the first entries of `change`) for rates w at positions q:
+  /// a joint coordinate moves with its rate, a free root's quaternion as in Spatial.
+  void configuration_change(const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& w,
+                            Eigen::Ref<Eigen::VectorXd> change) const {
+    for (const TreeBody& node : tree_) {
+      if (node.free)
+        change.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
+            q.segment<Spatial::nq>(node.q_offset), w.segment<Spatial::nv>(node.v_offset));
+      else
+        change.segment(node.q_offset, node.dof()) = w.segment(node.v_offset, node.dof());
     }
   }
 
