@@ -111,4 +111,24 @@ TEST_CASE("a dop853 step allocates nothing, in absolute and in joint coordinates
   check(std::type_identity<odyn::JointDormandPrince853<engine::Model>>{});
 }
 
+TEST_CASE("a time step allocates nothing on the sparse paths (CHOLMOD's Schur complement, KLU)",
+          "[workspace][sparse]") {
+  // The engine's generalized-alpha run with each sparse factorization forced; under the
+  // sanitizer the count includes the SuiteSparse libraries' own mallocs.
+  for (const odyn::LinearSolver choice : {odyn::LinearSolver::cholmod, odyn::LinearSolver::klu}) {
+    INFO(odyn::linear_solver_name(choice));
+    engine::Engine e = engine::build();
+    odyn::Workspace<engine::Model> ws(e.model);
+    odyn::assemble(e.model, ws);
+    odyn::GeneralizedAlpha<engine::Model> integrator(e.model, ws, {.linear_solver = choice});
+    for (int i = 0; i < 10; ++i) integrator.step(1e-4);  // warm up
+    allocations = 0;
+    counting = true;
+    odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+    counting = false;
+    CHECK(integrator.statistics().events >= 2);
+    CHECK(allocations == 0);
+  }
+}
+
 }  // namespace test_allocation

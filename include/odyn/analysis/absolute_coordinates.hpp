@@ -21,11 +21,13 @@ class AbsoluteCoordinates {
  public:
   static constexpr const char* name = "absolute";
 
-  AbsoluteCoordinates(const Model& model, Workspace<Model>& ws)
+  AbsoluteCoordinates(const Model& model, Workspace<Model>& ws,
+                      LinearSolver linear_solver = LinearSolver::automatic)
       : model_(model),
         ws_(ws),
         projection_(model),
         increment_(Eigen::VectorXd::Zero(model.num_velocities())) {
+    solver_.choose(linear_solver);
     solver_.analyze(model);
   }
 

@@ -17,8 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "odyn/analysis/sparse_assembly.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/linalg/linear_solver.hpp"
 #include "odyn/linalg/rank_revealing_qr.hpp"
 
 namespace odyn {
@@ -26,7 +28,13 @@ namespace odyn {
 struct AssemblySettings {
   double tolerance = 1e-12;  // |Phi| in every entry
   int max_iterations = 50;
+  /// dense: rank-revealing QR of whole matrices (small models); cholmod or klu: sparse rows and
+  /// a sparse LU, linear in the model's size; auto: sparse above dense_assembly_limit unknowns.
+  LinearSolver linear_solver = LinearSolver::automatic;
 };
+
+/// Velocities plus constraint equations up to which `auto` assembles with dense matrices.
+inline constexpr int dense_assembly_limit = 300;
 
 struct AssemblyReport {
   int iterations = 0;
@@ -94,13 +102,112 @@ Eigen::MatrixXd dense_mass(const Model& model) {
   return mass;
 }
 
-/// Names of the constraint equations that depend on earlier ones (rank-revealing QR of Phi_q^T).
+/// Whether the assembly runs on sparse rows (see AssemblySettings::linear_solver).
 template <class Model>
-std::vector<std::string> redundant_equations(const Model& model, const Eigen::MatrixXd& jacobian) {
-  std::vector<std::string> names;
-  for (const int row : dependent_rows(jacobian))
-    names.push_back(model.constraint_name(row) + " (equation " + std::to_string(row) + ")");
-  return names;
+bool sparse_assembly(const Model& model, const AssemblySettings& s) {
+  if (s.linear_solver == LinearSolver::automatic)
+    return model.num_velocities() + model.num_equations() > dense_assembly_limit;
+  return s.linear_solver != LinearSolver::dense;
+}
+
+/// The rows of Phi_q (at the blocks of the last evaluate_constraints) that depend on others:
+/// by a rank-revealing QR of the dense matrix for small models, and for large ones (past
+/// dense_assembly_limit) by sparse elimination in row order, which names the later of two
+/// dependent rows.
+template <class Model>
+std::vector<int> dependent_rows(const Model& model, const Workspace<Model>& ws) {
+  if (!sparse_assembly(model, AssemblySettings{})) return dependent_rows(dense_jacobian(model, ws));
+  const std::vector<char> independent =
+      independent_rows(sparse_jacobian(model, ws), rank_tolerance);
+  std::vector<int> rows;
+  for (int r = 0; r < static_cast<int>(independent.size()); ++r)
+    if (!independent[r]) rows.push_back(r);
+  return rows;
+}
+
+/// The mass matrix's block of body b (from 0), for the sparse solves.
+template <class Model>
+auto mass_blocks(const Model& model) {
+  return [&model](int b) { return model.body(BodyId{b + 1}).mass_block(); };
+}
+
+/// The minimum-norm Newton step of the positions, -Phi_q^+ Phi, on sparse rows: the rows that
+/// repeat earlier ones are left out (their residual follows from the others'), the rest solve
+/// [I Phi_q^T; Phi_q 0] [dq; y] = [0; -Phi]. Empty if that system is singular.
+template <class Model>
+Eigen::VectorXd sparse_position_step(const Model& model, const Workspace<Model>& ws) {
+  constexpr int nv = Model::nv;
+  const SparseRows rows = sparse_jacobian(model, ws);
+  const std::vector<char> use = independent_rows(rows, rank_tolerance);
+  Eigen::VectorXd g(std::count(use.begin(), use.end(), 1));
+  for (int r = 0, k = 0; r < rows.num_rows(); ++r)
+    if (use[r]) g[k++] = -ws.phi[r];
+  const auto identity = [](int) { return Eigen::Matrix<double, nv, nv>::Identity(); };
+  Eigen::VectorXd step, multipliers;
+  if (!solve_sparse_saddle_point<nv>(identity, rows, use, {},
+                                     Eigen::VectorXd::Zero(rows.num_columns), g, step, multipliers))
+    return {};
+  return step;
+}
+
+/// Velocities (keeping the given components that the constraints leave free, the rest
+/// changed as little as possible in the kinetic-energy metric), then accelerations and
+/// multipliers, on sparse rows. A constraint row that repeats earlier ones gets no multiplier
+/// (0): with redundant constraints the reactions are one valid choice, not the minimum-norm one
+/// of the dense assembly.
+template <class Model>
+void assemble_velocities_and_accelerations_sparse(const Model& model, Workspace<Model>& ws,
+                                                  const Eigen::VectorXd& user_velocity,
+                                                  AssemblyReport& report) {
+  constexpr int nv = Model::nv;
+  const int m = model.num_equations(), n = model.num_velocities();
+  const SparseRows rows = sparse_jacobian(model, ws);
+  const std::vector<char> use = independent_rows(rows, rank_tolerance);
+  const int independent = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  std::vector<int> given;
+  for (int b = 1; b <= model.num_bodies(); ++b) {
+    const auto components = model.body(BodyId{b}).given_components();
+    for (int k = 0; k < nv; ++k)
+      if (components[k]) given.push_back((b - 1) * nv + k);
+  }
+  const std::vector<char> keep = keepable_components(rows, use, given);
+  std::vector<int> kept;
+  for (std::size_t k = 0; k < given.size(); ++k)
+    (keep[k] ? report.kept_velocity_components : report.adjusted_velocity_components)
+        .push_back(given[k]);
+  kept = report.kept_velocity_components;
+  // min (v - v_user)^T M (v - v_user) subject to Phi_q v = -Phi_t and the kept components.
+  Eigen::VectorXd velocity_residual(m);
+  jacobian_times(model, ws, user_velocity, velocity_residual);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(independent + static_cast<int>(kept.size()));
+  for (int r = 0, k = 0; r < m; ++r)
+    if (use[r]) g[k++] = -ws.phi_t[r] - velocity_residual[r];
+  Eigen::VectorXd correction, multipliers;
+  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), rows, use, kept, Eigen::VectorXd::Zero(n),
+                                     g, correction, multipliers))
+    throw AssemblyError("assembly", "the velocity equations are singular (sparse assembly)");
+  ws.v = user_velocity + correction;
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  jacobian_times(model, ws, ws.v, velocity_residual);
+  report.velocity_residual = m > 0 ? (velocity_residual + ws.phi_t).cwiseAbs().maxCoeff() : 0.0;
+
+  // Accelerations and multipliers.
+  initialize_states(model, ws);
+  evaluate_forces(model, ws);
+  evaluate_gamma(model, ws);
+  const SparseRows moved = sparse_jacobian(model, ws);
+  g.resize(independent);
+  for (int r = 0, k = 0; r < m; ++r)
+    if (use[r]) g[k++] = ws.gamma[r];
+  Eigen::VectorXd vdot;
+  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), moved, use, {}, ws.force, g, vdot,
+                                     multipliers))
+    throw AssemblyError("assembly", "the mass-constraint matrix is singular (sparse assembly)");
+  ws.vdot = vdot;
+  ws.lambda.setZero();
+  for (int r = 0, k = 0; r < m; ++r)
+    if (use[r]) ws.lambda[r] = multipliers[k++];
 }
 
 /// Minimum-norm solution of the saddle-point system [A C^T; C 0] [x; y] = [f; g].
@@ -144,12 +251,17 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
     return m > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
   };
   double norm = residual_norm();
+  const bool sparse = detail::sparse_assembly(model, s);
   int iteration = 0;
   for (; iteration < s.max_iterations && norm > s.tolerance && std::isfinite(norm); ++iteration) {
-    const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
-    // Rank to rounding: a step along nearly dependent rows is still a step toward Phi = 0.
-    const double threshold = std::numeric_limits<double>::epsilon() * static_cast<double>(m);
-    const Eigen::VectorXd step = -RankRevealingQr(jacobian, threshold).solve(ws.phi);
+    Eigen::VectorXd step;
+    if (sparse) step = detail::sparse_position_step(model, ws);
+    if (step.size() == 0) {
+      const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
+      // Rank to rounding: a step along nearly dependent rows is still a step toward Phi = 0.
+      const double threshold = std::numeric_limits<double>::epsilon() * static_cast<double>(m);
+      step = -RankRevealingQr(jacobian, threshold).solve(ws.phi);
+    }
     const Eigen::VectorXd start = ws.q;
     // Halve the step until the residual decreases: a damped Newton method.
     double fraction = 1.0;
@@ -195,10 +307,13 @@ AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const Assembly
   report.iterations = assemble_positions(model, ws, s);
   report.position_residual = model.num_equations() > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
 
+  if (detail::sparse_assembly(model, s)) {
+    detail::assemble_velocities_and_accelerations_sparse(model, ws, user_velocity, report);
+    return report;
+  }
   const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
   const Eigen::MatrixXd mass = detail::dense_mass(model);
   const int m = model.num_equations(), n = model.num_velocities();
-
   // Keep given velocity components one by one while they stay independent of the rest.
   Eigen::MatrixXd rows = jacobian;
   Eigen::VectorXd rhs = -ws.phi_t;
@@ -242,7 +357,6 @@ AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const Assembly
   detail::solve_saddle_point(mass, jacobian, ws.force, ws.gamma, vdot, lambda);
   ws.vdot = vdot;
   ws.lambda = lambda;
-  (void)n;
   return report;
 }
 
@@ -254,7 +368,7 @@ std::vector<RedundantEquation> redundant_equations(const Model& model, Workspace
   update_frames(model, ws);
   evaluate_constraints(model, ws);
   std::vector<RedundantEquation> redundant;
-  for (const int row : detail::dependent_rows(detail::dense_jacobian(model, ws)))
+  for (const int row : detail::dependent_rows(model, ws))
     redundant.push_back(detail::locate_row(model, row));
   return redundant;
 }
@@ -264,7 +378,9 @@ template <class Model>
 void require_independent_constraints(const Model& model, Workspace<Model>& ws) {
   update_frames(model, ws);
   evaluate_constraints(model, ws);
-  const auto redundant = detail::redundant_equations(model, detail::dense_jacobian(model, ws));
+  std::vector<std::string> redundant;
+  for (const int row : detail::dependent_rows(model, ws))
+    redundant.push_back(model.constraint_name(row) + " (equation " + std::to_string(row) + ")");
   if (redundant.empty()) return;
   std::string list;
   for (const auto& name : redundant) list += (list.empty() ? "" : ", ") + name;

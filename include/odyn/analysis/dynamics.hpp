@@ -39,6 +39,10 @@ struct DynamicsSettings {
   /// close loops as constraints; spatial models; see analysis/joint_coordinates.hpp). The
   /// other integrators step absolute coordinates.
   std::string coordinates = "absolute";
+  /// The factorization of the linear systems, in the assembly and the integrator: "auto"
+  /// (dense for small models, sparse for large ones), "dense", "cholmod" or "klu"; see
+  /// linalg/linear_solver.hpp.
+  LinearSolver linear_solver = LinearSolver::automatic;
   /// Local error tolerances of the runs with error control, per component of (q, v).
   double rtol = 1e-6;
   double atol = 1e-6;
@@ -248,19 +252,26 @@ template <>
 inline GeneralizedAlphaSettings integrator_settings(const DynamicsSettings& s) {
   GeneralizedAlphaSettings settings = s.generalized_alpha;
   settings.hht = settings.hht || s.integrator == "hht";
+  settings.linear_solver = s.linear_solver;
   return settings;
 }
 template <>
 inline DormandPrinceSettings integrator_settings(const DynamicsSettings& s) {
-  return s.dormand_prince;
+  DormandPrinceSettings settings = s.dormand_prince;
+  settings.linear_solver = s.linear_solver;
+  return settings;
 }
 template <>
 inline BdfSettings integrator_settings(const DynamicsSettings& s) {
-  return s.bdf;
+  BdfSettings settings = s.bdf;
+  settings.linear_solver = s.linear_solver;
+  return settings;
 }
 template <>
 inline AdamsSettings integrator_settings(const DynamicsSettings& s) {
-  return s.adams;
+  AdamsSettings settings = s.adams;
+  settings.linear_solver = s.linear_solver;
+  return settings;
 }
 
 inline StepControl step_control(const DynamicsSettings& s) {
@@ -305,7 +316,9 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   static_assert(StepIntegrator<Integrator>);
   const auto start = std::chrono::steady_clock::now();
   RunSummary summary;
-  summary.assembly = assemble(model, ws, s.assembly);
+  AssemblySettings assembly = s.assembly;
+  assembly.linear_solver = s.linear_solver;
+  summary.assembly = assemble(model, ws, assembly);
   summary.redundant_equations = redundant_equations(model, ws);
   Integrator integrator(model, ws, detail::integrator_settings<typename Integrator::Settings>(s),
                         detail::step_control(s));

@@ -49,6 +49,7 @@
 #include "odyn/core/spatial.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
+#include "odyn/linalg/linear_solver.hpp"
 #include "odyn/linalg/saddle_point_ldlt.hpp"
 #include "odyn/spatial/screw.hpp"
 
@@ -67,7 +68,10 @@ class JointCoordinates {
 
   /// Builds the tree at the workspace's (assembled) state and takes that state as the start.
   /// Throws ModelError if the loop closures are redundant there.
-  JointCoordinates(const Model& model, Workspace<Model>& ws) : model_(model), ws_(ws) {
+  /// (The closures' matrix is small and dense: `linear_solver` is not used.)
+  JointCoordinates(const Model& model, Workspace<Model>& ws,
+                   LinearSolver /*linear_solver*/ = LinearSolver::automatic)
+      : model_(model), ws_(ws) {
     update_frames(model, ws);
     build_tree();
     size_buffers();

@@ -41,6 +41,9 @@ namespace odyn {
 struct AdamsSettings {
   /// Order k of the method, 1 to 6: k past derivatives per step.
   int order = 5;
+  /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
+  LinearSolver linear_solver = LinearSolver::automatic;
+
   /// Positions are projected when an entry of Phi exceeds this (|Phi| then stays below about
   /// 4e-11 on the engine)...
   double projection_tolerance = 1e-11;
@@ -68,7 +71,7 @@ class AdamsBashforth {
         control_(control),
         starter_(model, ws,
                  DormandPrinceSettings{settings.projection_tolerance,
-                                       settings.max_projection_iterations},
+                                       settings.max_projection_iterations, settings.linear_solver},
                  control),
         projection_(model) {
     if (settings.order < 1 || settings.order > kMaxOrder)
@@ -86,6 +89,7 @@ class AdamsBashforth {
     y_new_ = y_n_;
     estimate_ = y_n_;
     for (auto& f : history_) f = y_n_;
+    solver_.choose(settings.linear_solver);
     solver_.analyze(model);
     initialize();
   }

@@ -53,6 +53,9 @@ namespace odyn {
 
 struct BdfSettings {
   int max_order = 5;  // 1 to 5
+  /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
+  LinearSolver linear_solver = LinearSolver::automatic;
+
   /// Newton stops when the estimated distance to the solution, in units of the error
   /// tolerance, is below this...
   double newton_tolerance = 0.1;
@@ -121,6 +124,8 @@ class Bdf {
     v_n_ = ws.v;
     vdot_n_ = ws.vdot;
     lambda_n_ = ws.lambda;
+    solver_.choose(settings.linear_solver);
+    output_solver_.choose(settings.linear_solver);
     solver_.analyze(model);
     projector_.analyze(model);
     output_solver_.analyze(model);

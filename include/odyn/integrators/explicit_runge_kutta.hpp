@@ -40,6 +40,8 @@ struct DormandPrinceSettings {
   /// Positions are projected until every entry of Phi is below this.
   double projection_tolerance = 1e-12;
   int max_projection_iterations = 6;
+  /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
+  LinearSolver linear_solver = LinearSolver::automatic;
 };
 
 /// What a method type gives the integrator below, with s = stages (k_0 = f at the committed
@@ -89,7 +91,7 @@ class ExplicitRungeKutta {
         ws_(ws),
         settings_(settings),
         control_(control),
-        coordinates_(model, ws),
+        coordinates_(model, ws, settings.linear_solver),
         proposed_step_(std::min(control.first_step, control.max_step)) {
     if (!(control.rtol > 0.0) || !(control.atol > 0.0))
       throw ModelError(Method::name, "rtol and atol must be positive, got " +

@@ -47,6 +47,8 @@ struct GeneralizedAlphaSettings {
   /// every change of h costs the index-3 scheme some accuracy (on the engine, 1.2 gives 3 to 8
   /// times smaller errors than 2 for the same number of steps).
   double max_growth = 1.2;
+  /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
+  LinearSolver linear_solver = LinearSolver::automatic;
 };
 
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
@@ -103,6 +105,7 @@ class GeneralizedAlpha {
     for (int b = 1; b <= model.num_bodies(); ++b)
       inverse_mass_diagonal_.template segment<nv>((b - 1) * nv) =
           model.body(BodyId{b}).mass_block().diagonal().cwiseInverse();
+    solver_.choose(settings.linear_solver);
     solver_.analyze(model);
     initialize();
   }

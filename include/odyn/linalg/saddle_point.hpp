@@ -3,15 +3,19 @@
 //   [A  B^T] [x]   [f]
 //   [B  0  ] [y] = [g],   A = mass_factor M + stiffness_factor K + damping_factor C,  B = Phi_q,
 // behind one interface: analyze(model) once per model, factorize(model, ws, factors) per
-// matrix values, solve(rhs, solution). Two implementations:
-//  - DenseSaddlePoint: assembles the whole matrix and factorizes it by dense LU; general.
-//  - BlockSchurSaddlePoint: when A is block diagonal (no force element couples two moving
-//    bodies in the Newton matrix), inverts A body by body and factorizes only the m x m Schur
-//    complement B A^-1 B^T; several times cheaper for small and medium models. It falls back
-//    to the dense solver by itself when A is not block diagonal. S is assembled from the
-//    elements' own Jacobian blocks in the workspace, one fixed-size product per pair of
-//    blocks on a body (the pairs are listed once, by analyze, under their two element types),
-//    so no loop in factorize or solve runs over a row count known only at run time.
+// matrix values, solve(rhs, solution). The integrators hold a BlockSchurSaddlePoint, which
+// chooses among four factorizations at analyze (choose(LinearSolver), see
+// linalg/linear_solver.hpp; by size and pattern when automatic):
+//  - the Schur complement, when A is block diagonal (no force element couples two moving
+//    bodies in the Newton matrix): A is inverted body by body and only the m x m complement
+//    S = B A^-1 B^T is factorized, dense by an envelope Cholesky (small models: several times
+//    cheaper than a whole-matrix LU) or sparse by CHOLMOD (large ones: linear cost on chains
+//    and trees). S is assembled from the elements' own Jacobian blocks in the workspace, one
+//    fixed-size product per pair of blocks on a body (the pairs are listed once, by analyze,
+//    under their two element types), so no loop in factorize or solve runs over a row count
+//    known only at run time;
+//  - the whole matrix, when A is not block diagonal: DenseSaddlePoint's dense LU for small
+//    models, SparseKktSaddlePoint's KLU (analysis/sparse_kkt.hpp) for large ones.
 //
 // Redundant constraints. When B = Phi_q is rank-deficient (a mechanism whose joints repeat one
 // another's equations, such as Bricard's linkage, or two coaxial hinges), the matrix is singular
@@ -41,26 +45,25 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <tuple>
 #include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/core/errors.hpp"
+#include "odyn/linalg/block_sparse.hpp"
 #include "odyn/linalg/dense_lu.hpp"
+#include "odyn/linalg/linear_solver.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/rank_revealing_qr.hpp"
 #include "odyn/linalg/small_cholesky.hpp"
+#include "odyn/linalg/sparse_cholesky.hpp"
 
 namespace odyn {
-
-/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block.
-struct IterationFactors {
-  double mass = 1.0;
-  double stiffness = 0.0;
-  double damping = 0.0;
-};
 
 template <class Model>
 class DenseSaddlePoint {
@@ -156,10 +159,24 @@ class BlockSchurSaddlePoint {
   static constexpr int nv = Model::nv;
   using Block = Eigen::Matrix<double, nv, nv>;
 
+  /// The factorization to use from the next analyze on (default: automatic).
+  void choose(LinearSolver solver) { choice_ = solver; }
+
+  /// Sizes below which `automatic` keeps the dense factorizations: constraint equations for the
+  /// Schur complement, unknowns for the whole matrix. Measured on spherical chains (bench/
+  /// bench_scaling.cpp): the dense kernels win on the engine-sized models they were tuned for,
+  /// the sparse ones from a few dozen bodies on.
+  static constexpr int dense_schur_limit = 120;
+  static constexpr int dense_kkt_limit = 60;
+
   void analyze(const Model& model) {
-    dense_fallback_ = detail::couples_bodies(model);
-    if (dense_fallback_) {
+    path_ = choose_path(model);
+    if (path_ == Path::dense_kkt) {
       dense_.analyze(model);
+      return;
+    }
+    if (path_ == Path::sparse_kkt) {
+      sparse_kkt_.analyze(model);
       return;
     }
     bodies_ = model.num_bodies();
@@ -203,11 +220,27 @@ class BlockSchurSaddlePoint {
             envelope_end[column] =
                 std::max<Eigen::Index>(envelope_end[column], lower.row + lower.equations);
         }
-    schur_ = Eigen::MatrixXd::Zero(m_, m_);
-    schur_cholesky_.resize(m_, envelope_end);
-    schur_lu_.resize(m_);
-    // Sized by a first computation, so that a singular S later allocates nothing.
-    schur_minimum_norm_.compute(Eigen::MatrixXd::Identity(m_, m_), rank_tolerance);
+    if (path_ == Path::sparse_schur) {
+      // The blocks of S: one per constraint element on the diagonal, one per coupling below it.
+      schur_ = Eigen::MatrixXd();
+      sparse_schur_.reset(m_);
+      model.for_each_pool([&]<class E>(const std::vector<E>&, auto) {
+        if constexpr (Constraint<E>)
+          for (const int row : model.template rows<E>())
+            sparse_schur_.declare(row, row, E::num_equations, E::num_equations);
+      });
+      for (const auto& list : couplings_)
+        for (const auto& [lower, upper] : list)
+          sparse_schur_.declare(lower.row, upper.row, lower.equations, upper.equations);
+      sparse_schur_.finalize(BlockSparseMatrix::Triangle::lower);
+      sparse_cholesky_.analyze(m_, sparse_schur_.column_starts(), sparse_schur_.row_indices());
+    } else {
+      schur_ = Eigen::MatrixXd::Zero(m_, m_);
+      schur_cholesky_.resize(m_, envelope_end);
+      schur_lu_.resize(m_);
+      // Sized by a first computation, so that a singular S later allocates nothing.
+      schur_minimum_norm_.compute(Eigen::MatrixXd::Identity(m_, m_), rank_tolerance);
+    }
     work_m_ = Eigen::VectorXd::Zero(m_);
     work_y_ = Eigen::VectorXd::Zero(m_);
     work_qr_ = Eigen::VectorXd::Zero(m_);
@@ -216,52 +249,49 @@ class BlockSchurSaddlePoint {
   }
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
-    if (dense_fallback_) return dense_.factorize(model, ws, f);
+    if (path_ == Path::dense_kkt) return dense_.factorize(model, ws, f);
+    if (path_ == Path::sparse_kkt) return sparse_kkt_.factorize(model, ws, f);
     if (!invert_blocks(model, ws, f)) return false;
-    // S = B A^-1 B^T, block by block: each block B_e of B (element e's rows on body b) is
-    // weighted, W_e = B_e A_b^-1, and gives S_ee += W_e B_e^T; each pair of blocks on one body
-    // gives the off-diagonal block W_e B_f^T. All sizes are fixed at compile time.
-    schur_.setZero();
-    for_each_type([&]<class E, std::size_t T>() {
-      constexpr int m = E::num_equations;
-      const auto& blocks = std::get<T>(ws.blocks);
-      auto& weighted = std::get<T>(weighted_);
-      for (const BlockRef& ref : block_refs_[T]) {
-        const auto& jacobian = blocks[ref.element].jacobian[ref.side];
-        auto& w = weighted[ref.element][ref.side];
-        const Block& inverse = inverses_[ref.body];
-        if (diagonal_inverse_[ref.body])  // principal axes at the centre of mass
-          w = jacobian * inverse.diagonal().asDiagonal();
-        else
-          w.noalias() = jacobian * inverse;  // A_b^-1 is symmetric
-        schur_.template block<m, m>(ref.row, ref.row).noalias() += w * jacobian.transpose();
-      }
-    });
-    for_each_type([&]<class E, std::size_t T>() {
-      for_each_type([&]<class F, std::size_t U>() {
-        const auto& weighted = std::get<T>(weighted_);
-        const auto& blocks = std::get<U>(ws.blocks);
-        for (const auto& [lower, upper] : couplings_[T * Model::num_types + U])
-          schur_.template block<E::num_equations, F::num_equations>(lower.row, upper.row)
-              .noalias() += weighted[lower.element][lower.side] *
-                            blocks[upper.element].jacobian[upper.side].transpose();
-      });
-    });
+    if (path_ == Path::sparse_schur) {
+      sparse_schur_.set_zero();
+      assemble_schur(ws, sparse_schur_);
+    } else {
+      schur_.setZero();
+      assemble_schur(ws, schur_);
+    }
     if (m_ == 0) {
       rank_deficiency_ = 0;
       return true;
     }
-    return factorize_schur();
+    return path_ == Path::sparse_schur ? factorize_sparse_schur() : factorize_schur();
   }
 
   /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
   int rank_deficiency() const {
-    return dense_fallback_ ? dense_.rank_deficiency() : rank_deficiency_;
+    if (path_ == Path::dense_kkt) return dense_.rank_deficiency();
+    if (path_ == Path::sparse_kkt) return sparse_kkt_.rank_deficiency();
+    return rank_deficiency_;
+  }
+
+  /// The factorization the last analyze chose: "dense-schur", "cholmod-schur", "dense-lu" or
+  /// "klu".
+  const char* path_name() const {
+    switch (path_) {
+      case Path::sparse_schur:
+        return "cholmod-schur";
+      case Path::dense_kkt:
+        return "dense-lu";
+      case Path::sparse_kkt:
+        return "klu";
+      default:
+        return "dense-schur";
+    }
   }
 
   /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    if (dense_fallback_) return dense_.solve(rhs, solution);
+    if (path_ == Path::dense_kkt) return dense_.solve(rhs, solution);
+    if (path_ == Path::sparse_kkt) return sparse_kkt_.solve(rhs, solution);
     // B A^-1 f = sum over the blocks of W_e f_b.
     work_m_ = -rhs.tail(m_);
     for_each_weighted([&](const BlockRef& ref, const auto& w) {
@@ -272,6 +302,10 @@ class BlockSchurSaddlePoint {
       case Method::cholesky:
         solution.tail(m_) = work_m_;
         schur_cholesky_.solve_in_place(solution.tail(m_));
+        break;
+      case Method::sparse_cholesky:
+        solution.tail(m_) = work_m_;
+        sparse_cholesky_.solve_in_place(solution.tail(m_));
         break;
       case Method::lu:
         solution.tail(m_) = work_m_;
@@ -298,7 +332,66 @@ class BlockSchurSaddlePoint {
   }
 
  private:
-  enum class Method { cholesky, lu, minimum_norm };
+  enum class Method { cholesky, sparse_cholesky, lu, minimum_norm };
+  enum class Path { dense_schur, sparse_schur, dense_kkt, sparse_kkt };
+
+  /// What to factorize: the Schur complement needs A block diagonal (no force element's Newton
+  /// blocks join two moving bodies).
+  Path choose_path(const Model& model) const {
+    const bool coupled = detail::couples_bodies(model);
+    switch (choice_) {
+      case LinearSolver::dense:
+        return coupled ? Path::dense_kkt : Path::dense_schur;
+      case LinearSolver::klu:
+        return Path::sparse_kkt;
+      case LinearSolver::cholmod:
+        if (coupled)
+          throw ModelError("linear_solver",
+                           "cholmod factorizes the Schur complement B A^-1 B^T, which needs the "
+                           "bodies uncoupled in A, but a force element here joins two moving "
+                           "bodies; choose klu (or auto) for this model");
+        return Path::sparse_schur;
+      default:
+        if (coupled)
+          return model.num_velocities() + model.num_equations() <= dense_kkt_limit
+                     ? Path::dense_kkt
+                     : Path::sparse_kkt;
+        return model.num_equations() <= dense_schur_limit ? Path::dense_schur : Path::sparse_schur;
+    }
+  }
+
+  /// Adds S = B A^-1 B^T into `target` (a dense matrix or the sparse one), block by block:
+  /// each block B_e of B (element e's rows on body b) is weighted, W_e = B_e A_b^-1, and gives
+  /// S_ee += W_e B_e^T; each pair of blocks on one body gives the off-diagonal block W_e B_f^T.
+  /// All sizes are fixed at compile time.
+  template <class Target>
+  void assemble_schur(const Workspace<Model>& ws, Target& target) {
+    for_each_type([&]<class E, std::size_t T>() {
+      constexpr int m = E::num_equations;
+      const auto& blocks = std::get<T>(ws.blocks);
+      auto& weighted = std::get<T>(weighted_);
+      for (const BlockRef& ref : block_refs_[T]) {
+        const auto& jacobian = blocks[ref.element].jacobian[ref.side];
+        auto& w = weighted[ref.element][ref.side];
+        const Block& inverse = inverses_[ref.body];
+        if (diagonal_inverse_[ref.body])  // principal axes at the centre of mass
+          w = jacobian * inverse.diagonal().asDiagonal();
+        else
+          w.noalias() = jacobian * inverse;  // A_b^-1 is symmetric
+        target.template block<m, m>(ref.row, ref.row).noalias() += w * jacobian.transpose();
+      }
+    });
+    for_each_type([&]<class E, std::size_t T>() {
+      for_each_type([&]<class F, std::size_t U>() {
+        const auto& weighted = std::get<T>(weighted_);
+        const auto& blocks = std::get<U>(ws.blocks);
+        for (const auto& [lower, upper] : couplings_[T * Model::num_types + U])
+          target.template block<E::num_equations, F::num_equations>(lower.row, upper.row)
+              .noalias() += weighted[lower.element][lower.side] *
+                            blocks[upper.element].jacobian[upper.side].transpose();
+      });
+    });
+  }
 
   /// One block of B: element `element` of its type, its body number `side`, that body's index
   /// from 0, the element's first row and its number of rows.
@@ -371,6 +464,25 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
+  /// Factorizes the sparse S by CHOLMOD. When S is not positive definite or nearly singular
+  /// (A indefinite, or redundant constraints), it goes the dense way below: correct, but
+  /// O(m^3), so large over-constrained models are not on the linear-cost path yet.
+  bool factorize_sparse_schur() {
+    rank_deficiency_ = 0;
+    const std::vector<double>& values = sparse_schur_.gather();
+    if (sparse_cholesky_.factorize(values) &&
+        sparse_cholesky_.reciprocal_condition() > rank_tolerance) {
+      method_ = Method::sparse_cholesky;
+      return true;
+    }
+    for (const double x : values)
+      if (!std::isfinite(x)) return false;
+    schur_ = sparse_schur_.to_dense();
+    schur_cholesky_.resize(m_);
+    schur_lu_.resize(m_);
+    return factorize_schur();
+  }
+
   /// Factorizes the assembled S: Cholesky, else LU, else (singular) a complete orthogonal
   /// decomposition.
   bool factorize_schur() {
@@ -402,8 +514,10 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
-  bool dense_fallback_ = false;
-  DenseSaddlePoint<Model> dense_;
+  LinearSolver choice_ = LinearSolver::automatic;
+  Path path_ = Path::dense_schur;
+  DenseSaddlePoint<Model> dense_;           // path dense_kkt
+  SparseKktSaddlePoint<Model> sparse_kkt_;  // path sparse_kkt
   int bodies_ = 0, n_ = 0, m_ = 0;
   Method method_ = Method::cholesky;
   int rank_deficiency_ = 0;
@@ -414,7 +528,9 @@ class BlockSchurSaddlePoint {
   std::array<std::vector<BlockRef>, Model::num_types> block_refs_;  // blocks of B, by type
   std::array<std::vector<Coupling>, Model::num_types * Model::num_types> couplings_;
   typename WeightedPools<Model>::type weighted_;  // W_e = B_e A_b^-1, laid out like ws.blocks
-  Eigen::MatrixXd schur_;                         // (m x m) S = B A^-1 B^T
+  Eigen::MatrixXd schur_;                         // (m x m) S = B A^-1 B^T (path dense_schur)
+  BlockSparseMatrix sparse_schur_;                // its lower triangle (path sparse_schur)
+  SparseCholesky sparse_cholesky_;
   SmallCholesky schur_cholesky_;
   PivotedLu schur_lu_;                  // S not positive definite
   RankRevealingQr schur_minimum_norm_;  // S singular

@@ -1,0 +1,175 @@
+#pragma once
+// The assembly's linear algebra for large models, at a cost linear in the model's size: Phi_q
+// as sparse rows, which rows repeat earlier ones (linalg/sparse_basis.hpp), which given
+// velocity components can be kept, and the saddle-point solves of the assembly's three
+// stages by a sparse LU. analysis/assembly.hpp chooses between these and its dense
+// counterparts (which small models keep, with their numbers unchanged).
+//
+// Which velocity components can be kept. The dense assembly keeps the given components one
+// by one, in order, while each stays independent of the constraint rows and of the
+// components kept before it. In matroid terms it builds a greedy independent set of the
+// unit rows e_i over the row space of Phi_q; its complement among the given components, the
+// ones left free, is then a greedy basis, in the reverse order, of the columns of Phi_q
+// after those of the components not given (the dual matroid's greedy set is the complement of
+// the primal's, taken in the reverse order). So the columns of Phi_q are taken one at a time:
+// first the components not given, then the given ones from the last to the first; a given
+// component whose column is independent of those before it stays free (it is adjusted), the
+// others are kept. Same decisions as the dense assembly, on vectors of the size of one
+// joint's rows instead of whole matrices.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <vector>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
+#include "odyn/linalg/sparse_basis.hpp"
+#include "odyn/linalg/sparse_lu.hpp"
+
+namespace odyn::detail {
+
+/// Phi_q by rows: row r's entries are k in [starts[r], starts[r + 1]).
+struct SparseRows {
+  int num_columns = 0;
+  std::vector<int> starts;
+  std::vector<int> columns;
+  std::vector<double> values;
+  int num_rows() const { return static_cast<int>(starts.size()) - 1; }
+};
+
+/// Phi_q from the Jacobian blocks of the last evaluate_constraints.
+template <class Model>
+SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
+  constexpr int nv = Model::nv;
+  const int m = model.num_equations();
+  SparseRows rows;
+  rows.num_columns = model.num_velocities();
+  rows.starts.assign(static_cast<std::size_t>(m) + 1, 0);
+  for_each_jacobian_block(model, ws, [&](int row, int, const auto& block) {
+    for (int i = 0; i < static_cast<int>(block.rows()); ++i) rows.starts[row + i + 1] += nv;
+  });
+  for (int r = 0; r < m; ++r) rows.starts[r + 1] += rows.starts[r];
+  rows.columns.resize(static_cast<std::size_t>(rows.starts[m]));
+  rows.values.resize(rows.columns.size());
+  std::vector<int> next(rows.starts.begin(), rows.starts.end() - 1);
+  for_each_jacobian_block(model, ws, [&](int row, int column, const auto& block) {
+    for (int i = 0; i < static_cast<int>(block.rows()); ++i)
+      for (int j = 0; j < nv; ++j) {
+        const int k = next[row + i]++;
+        rows.columns[k] = column + j;
+        rows.values[k] = block(i, j);
+      }
+  });
+  return rows;
+}
+
+/// For each row of Phi_q: false if it depends on the rows before it.
+inline std::vector<char> independent_rows(const SparseRows& rows, double tolerance) {
+  SparseBasis basis;
+  basis.reset(rows.num_columns, tolerance);
+  std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()));
+  std::vector<int> indices;
+  std::vector<double> values;
+  for (int r = 0; r < rows.num_rows(); ++r) {
+    indices.assign(rows.columns.begin() + rows.starts[r],
+                   rows.columns.begin() + rows.starts[r + 1]);
+    values.assign(rows.values.begin() + rows.starts[r], rows.values.begin() + rows.starts[r + 1]);
+    independent[r] = basis.add(indices, values) ? 1 : 0;
+  }
+  return independent;
+}
+
+/// Which given velocity components (indices into v, in the order the dense assembly takes
+/// them) can be kept with the independent rows of Phi_q; see the top of this file.
+inline std::vector<char> keepable_components(const SparseRows& rows,
+                                             const std::vector<char>& independent_row,
+                                             const std::vector<int>& given) {
+  const int n = rows.num_columns;
+  // Phi_q's independent rows by columns.
+  std::vector<int> column_starts(static_cast<std::size_t>(n) + 1, 0);
+  for (int r = 0; r < rows.num_rows(); ++r)
+    if (independent_row[r])
+      for (int k = rows.starts[r]; k < rows.starts[r + 1]; ++k)
+        ++column_starts[rows.columns[k] + 1];
+  for (int j = 0; j < n; ++j) column_starts[j + 1] += column_starts[j];
+  std::vector<int> row_of(static_cast<std::size_t>(column_starts[n]));
+  std::vector<double> value_of(row_of.size());
+  std::vector<int> next(column_starts.begin(), column_starts.end() - 1);
+  for (int r = 0; r < rows.num_rows(); ++r)
+    if (independent_row[r])
+      for (int k = rows.starts[r]; k < rows.starts[r + 1]; ++k) {
+        const int at = next[rows.columns[k]]++;
+        row_of[at] = r;
+        value_of[at] = rows.values[k];
+      }
+  SparseBasis basis;
+  basis.reset(rows.num_rows(), rank_tolerance);
+  std::vector<int> indices;
+  std::vector<double> values;
+  const auto add_column = [&](int j) {
+    indices.assign(row_of.begin() + column_starts[j], row_of.begin() + column_starts[j + 1]);
+    values.assign(value_of.begin() + column_starts[j], value_of.begin() + column_starts[j + 1]);
+    return basis.add(indices, values);
+  };
+  std::vector<char> is_given(static_cast<std::size_t>(n), 0);
+  for (const int j : given) is_given[j] = 1;
+  for (int j = 0; j < n; ++j)
+    if (!is_given[j]) add_column(j);
+  std::vector<char> keep(given.size(), 0);
+  for (std::size_t k = given.size(); k-- > 0;) keep[k] = add_column(given[k]) ? 0 : 1;
+  return keep;
+}
+
+/// Solves [D R^T; R 0] [x; y] = [f; g] by a sparse LU, where D is block diagonal (one
+/// nv x nv block per body) and R holds the rows of Phi_q marked in `use_row` followed by the
+/// unit rows e_i of `unit_rows`; y has one entry per row of R. False if the matrix is
+/// singular.
+template <int nv, class Blocks>
+bool solve_sparse_saddle_point(const Blocks& diagonal_blocks, const SparseRows& rows,
+                               const std::vector<char>& use_row, const std::vector<int>& unit_rows,
+                               const Eigen::VectorXd& f, const Eigen::VectorXd& g,
+                               Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int n = rows.num_columns;
+  std::vector<Eigen::Triplet<double, int>> entries;
+  for (int b = 0; b < n / nv; ++b) {
+    const auto block = diagonal_blocks(b);
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nv; ++i)
+        if (block(i, j) != 0.0) entries.emplace_back(b * nv + i, b * nv + j, block(i, j));
+  }
+  int r_size = 0;
+  for (int r = 0; r < rows.num_rows(); ++r) {
+    if (!use_row[r]) continue;
+    for (int k = rows.starts[r]; k < rows.starts[r + 1]; ++k) {
+      entries.emplace_back(n + r_size, rows.columns[k], rows.values[k]);
+      entries.emplace_back(rows.columns[k], n + r_size, rows.values[k]);
+    }
+    ++r_size;
+  }
+  for (const int i : unit_rows) {
+    entries.emplace_back(n + r_size, i, 1.0);
+    entries.emplace_back(i, n + r_size, 1.0);
+    ++r_size;
+  }
+  const int size = n + r_size;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> matrix(size, size);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  matrix.makeCompressed();
+  const std::vector<int> starts(matrix.outerIndexPtr(), matrix.outerIndexPtr() + size + 1);
+  const std::vector<int> row_indices(matrix.innerIndexPtr(),
+                                     matrix.innerIndexPtr() + matrix.nonZeros());
+  const std::vector<double> values(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
+  SparseLu lu;
+  lu.analyze(size, starts, row_indices);
+  if (!lu.factorize(values)) return false;
+  Eigen::VectorXd solution(size);
+  solution << f, g;
+  lu.solve_in_place(solution);
+  if (!solution.allFinite()) return false;
+  x = solution.head(n);
+  y = solution.tail(r_size);
+  return true;
+}
+
+}  // namespace odyn::detail

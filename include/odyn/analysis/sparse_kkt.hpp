@@ -1,0 +1,114 @@
+#pragma once
+// The whole saddle-point matrix of a model,
+//   [A  B^T]      A = mass_factor M + stiffness_factor K + damping_factor C,  B = Phi_q,
+//   [B  0  ],
+// kept sparse and factorized by a sparse LU (KLU with SuiteSparse; linalg/sparse_lu.hpp). For
+// models whose force elements couple moving bodies in A (springs, dampers, bushings between
+// bodies), where the Schur complement B A^-1 B^T would need A^-1 whole. The pattern is the
+// model's: one nv x nv block per body and per pair of bodies that a force element's Newton
+// blocks join, one block of B per constraint element and moving body, and its transpose. It is
+// declared once (analyze); each factorization writes the blocks in place and gathers them into
+// the compressed columns that KLU reads, so that a step builds no triplets and allocates
+// nothing. The LU keeps its pivot order from one factorization to the next while it stays
+// good (linalg/sparse_lu.hpp).
+//
+// A singular matrix (redundant constraints) falls back to a dense complete orthogonal
+// decomposition, which gives the minimum-norm multipliers as the dense solvers do
+// (linalg/saddle_point.hpp) but costs O((n + m)^3): large over-constrained models are not on
+// the linear-cost path yet.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "odyn/analysis/system.hpp"
+#include "odyn/linalg/block_sparse.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
+#include "odyn/linalg/sparse_lu.hpp"
+
+namespace odyn {
+
+/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block.
+struct IterationFactors {
+  double mass = 1.0;
+  double stiffness = 0.0;
+  double damping = 0.0;
+};
+
+template <class Model>
+class SparseKktSaddlePoint {
+ public:
+  static constexpr int nv = Model::nv;
+
+  void analyze(const Model& model) {
+    n_ = model.num_velocities();
+    m_ = model.num_equations();
+    matrix_.reset(n_ + m_);
+    for (int b = 0; b < model.num_bodies(); ++b) matrix_.declare(b * nv, b * nv, nv, nv);
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+      if constexpr (HasForceJacobians<E>) {
+        for (const E& element : pool)
+          for (const BodyId bi : element.bodies())
+            for (const BodyId bj : element.bodies())
+              if (!bi.is_ground() && !bj.is_ground())
+                matrix_.declare(Model::velocity_offset(bi), Model::velocity_offset(bj), nv, nv);
+      }
+      if constexpr (Constraint<E>) {
+        for (std::size_t i = 0; i < pool.size(); ++i)
+          for (const BodyId body : pool[i].bodies()) {
+            if (body.is_ground()) continue;
+            const int row = n_ + model.template rows<E>()[i];
+            const int column = Model::velocity_offset(body);
+            matrix_.declare(row, column, E::num_equations, nv);
+            matrix_.declare(column, row, nv, E::num_equations);
+          }
+      }
+    });
+    matrix_.finalize(BlockSparseMatrix::Triangle::full);
+    lu_.analyze(n_ + m_, matrix_.column_starts(), matrix_.row_indices());
+    rank_deficiency_ = 0;
+    minimum_norm_ = false;
+  }
+
+  /// Factorizes by sparse LU; if the matrix is singular (redundant constraints), by a dense
+  /// complete orthogonal decomposition. False only if the matrix holds non-finite values.
+  bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
+    matrix_.set_zero();
+    add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping);
+    write_jacobian(model, ws, matrix_, n_, 0, true);
+    const std::vector<double>& values = matrix_.gather();
+    rank_deficiency_ = 0;
+    minimum_norm_ = false;
+    if (lu_.factorize(values)) return true;
+    for (const double x : values)
+      if (!std::isfinite(x)) return false;
+    minimum_norm_ = true;
+    dense_.compute(matrix_.to_dense(), rank_tolerance);
+    rank_deficiency_ = static_cast<int>(n_ + m_ - dense_.rank());
+    return true;
+  }
+
+  /// rhs = [f; g] -> solution = [x; y] (minimum-norm y after a singular factorization).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    if (minimum_norm_) {
+      dense_.solve(rhs, solution, work_);
+      return;
+    }
+    solution = rhs;
+    lu_.solve_in_place(solution);
+  }
+
+  int rank_deficiency() const { return rank_deficiency_; }
+  /// Factorizations that chose their pivots afresh.
+  long pivoting_factorizations() const { return lu_.pivoting_factorizations(); }
+
+ private:
+  int n_ = 0, m_ = 0;
+  int rank_deficiency_ = 0;
+  bool minimum_norm_ = false;
+  BlockSparseMatrix matrix_;  // (n + m) x (n + m)
+  SparseLu lu_;
+  RankRevealingQr dense_;  // only after a singular factorization
+  Eigen::VectorXd work_;
+};
+
+}  // namespace odyn

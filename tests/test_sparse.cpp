@@ -1,0 +1,401 @@
+// The sparse path for large models, against independent references: the sparse
+// factorizations against Eigen's dense ones on systems with a known solution; the sparse
+// elimination's independence decisions against dense ranks; every saddle-point factorization
+// (dense, CHOLMOD's Schur complement, KLU's whole matrix) against the dense LU on the same
+// model matrices; the sparse assembly against the dense one; redundancy named on a large
+// model; and a chain's small oscillations on the sparse path against the frequencies of its
+// minimal-coordinate linearization, written out here from the Lagrangian.
+
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "engine_model.hpp"
+#include "odyn/linalg/block_sparse.hpp"
+#include "odyn/linalg/sparse_basis.hpp"
+#include "odyn/linalg/sparse_cholesky.hpp"
+#include "odyn/linalg/sparse_lu.hpp"
+
+namespace test_sparse {
+
+namespace sp = odyn::spatial;
+using Eigen::Vector3d;
+using ChainModel = sp::Model<sp::Spherical, sp::Gravity, sp::Tsda>;
+
+/// A deterministic number in [-1, 1] (no structure).
+double scrambled(int i, int j, double seed) {
+  const auto x = static_cast<double>(i), y = static_cast<double>(j);
+  return std::sin(seed + 12.9898 * x + 78.233 * y + 3.7 * x * y * (1.0 + y));
+}
+
+/// A block pattern like a model's: 3 x 3 blocks on the diagonal, between neighbours, and a few
+/// long-range ones, all in a `blocks` x `blocks` grid.
+odyn::BlockSparseMatrix grid_pattern(int blocks, odyn::BlockSparseMatrix::Triangle triangle) {
+  odyn::BlockSparseMatrix a;
+  a.reset(3 * blocks);
+  for (int i = 0; i < blocks; ++i) {
+    a.declare(3 * i, 3 * i, 3, 3);
+    const int partners[] = {i + 1, (7 * i + 3) % blocks};
+    for (const int j : partners) {
+      if (j >= blocks || j == i) continue;
+      const int lo = std::min(i, j), hi = std::max(i, j);
+      a.declare(3 * hi, 3 * lo, 3, 3);
+      if (triangle == odyn::BlockSparseMatrix::Triangle::full) a.declare(3 * lo, 3 * hi, 3, 3);
+    }
+  }
+  a.finalize(triangle);
+  return a;
+}
+
+TEST_CASE("Sparse Cholesky and sparse LU solve like Eigen's dense factorizations", "[sparse]") {
+  constexpr int blocks = 40;
+  SECTION("Cholesky of a symmetric positive definite matrix (lower triangle stored)") {
+    auto a = grid_pattern(blocks, odyn::BlockSparseMatrix::Triangle::lower);
+    // Off-diagonal entries in [-1, 1], and a diagonal large enough to dominate.
+    for (int id = 0; id < a.num_blocks(); ++id) {
+      auto block = a.block(id);
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) block(i, j) = scrambled(id, 3 * i + j, 0.7);
+    }
+    for (int i = 0; i < blocks; ++i) {
+      auto d = a.block<3, 3>(3 * i, 3 * i);
+      d = (0.5 * (d + d.transpose())).eval() + 20.0 * Eigen::Matrix3d::Identity();
+    }
+    a.gather();
+    const Eigen::MatrixXd dense = a.to_dense();
+    const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(3 * blocks, -1.0, 2.0);
+    odyn::SparseCholesky cholesky;
+    cholesky.analyze(a.dimension(), a.column_starts(), a.row_indices());
+    REQUIRE(cholesky.factorize(a.values()));
+    CHECK(cholesky.reciprocal_condition() > 1e-3);
+    Eigen::VectorXd x = dense * expected;
+    cholesky.solve_in_place(x);
+    CHECK((x - expected).norm() <= 1e-12 * expected.norm());
+    CHECK((x - dense.llt().solve(dense * expected)).norm() <= 1e-12 * expected.norm());
+    // Not positive definite: a negative pivot appears.
+    a.block<3, 3>(0, 0) = -Eigen::Matrix3d::Identity();
+    CHECK_FALSE(cholesky.factorize(a.gather()));
+  }
+  SECTION("Cholesky of a dense one (CHOLMOD takes it supernodal)") {
+    odyn::BlockSparseMatrix a;
+    a.reset(3 * blocks);
+    for (int j = 0; j < blocks; ++j)
+      for (int i = j; i < blocks; ++i) a.declare(3 * i, 3 * j, 3, 3);
+    a.finalize(odyn::BlockSparseMatrix::Triangle::lower);
+    for (int id = 0; id < a.num_blocks(); ++id) {
+      auto block = a.block(id);
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) block(i, j) = 0.1 * scrambled(id, 3 * i + j, 1.3);
+    }
+    for (int i = 0; i < blocks; ++i) {
+      auto d = a.block<3, 3>(3 * i, 3 * i);
+      d = (0.5 * (d + d.transpose())).eval() + 20.0 * Eigen::Matrix3d::Identity();
+    }
+    a.gather();
+    const Eigen::MatrixXd dense = a.to_dense();
+    const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(3 * blocks, 3.0, -1.0);
+    odyn::SparseCholesky cholesky;
+    cholesky.analyze(a.dimension(), a.column_starts(), a.row_indices());
+#ifdef ODYN_WITH_SUITESPARSE
+    CHECK(cholesky.supernodal());
+#endif
+    for (int repeat = 0; repeat < 2; ++repeat) {
+      REQUIRE(cholesky.factorize(a.values()));
+      Eigen::VectorXd x = dense * expected;
+      cholesky.solve_in_place(x);
+      CHECK((x - expected).norm() <= 1e-12 * expected.norm());
+    }
+    a.block<3, 3>(6, 6) = -Eigen::Matrix3d::Identity();
+    CHECK_FALSE(cholesky.factorize(a.gather()));
+  }
+  SECTION("LU of an unsymmetric matrix, refactorized with new values, and a singular one") {
+    auto a = grid_pattern(blocks, odyn::BlockSparseMatrix::Triangle::full);
+    odyn::SparseLu lu;
+    lu.analyze(a.dimension(), a.column_starts(), a.row_indices());
+    for (const double seed : {0.1, 0.2, 5.0}) {
+      INFO("seed " << seed);
+      for (int id = 0; id < a.num_blocks(); ++id) {
+        auto block = a.block(id);
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) block(i, j) = scrambled(id, 3 * i + j, seed);
+      }
+      for (int i = 0; i < blocks; ++i) a.block<3, 3>(3 * i, 3 * i).diagonal().array() += 3.0;
+      a.gather();
+      const Eigen::MatrixXd dense = a.to_dense();
+      const Eigen::VectorXd expected = Eigen::VectorXd::LinSpaced(3 * blocks, 2.0, -1.0);
+      REQUIRE(lu.factorize(a.values()));
+      Eigen::VectorXd x = dense * expected;
+      lu.solve_in_place(x);
+      CHECK((x - expected).norm() <= 1e-10 * expected.norm());
+      CHECK((x - dense.fullPivLu().solve(dense * expected)).norm() <= 1e-10 * expected.norm());
+    }
+    // Column 4 = column 1: singular.
+    for (int id = 0; id < a.num_blocks(); ++id) a.block(id).setZero();
+    for (int i = 0; i < blocks; ++i) a.block<3, 3>(3 * i, 3 * i).setIdentity();
+    a.block<3, 3>(3, 3).col(1) = a.block<3, 3>(3, 3).col(0);
+    CHECK_FALSE(lu.factorize(a.gather()));
+  }
+}
+
+TEST_CASE("Sparse elimination finds the same dependent vectors as dense ranks", "[sparse]") {
+  // Sparse vectors of dimension 60 with 4 entries each; every fifth one is a combination of
+  // two earlier ones, plus one vector of zeros and one repeated scaled copy.
+  constexpr int dimension = 60;
+  std::vector<Eigen::VectorXd> vectors;
+  for (int k = 0; k < 80; ++k) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(dimension);
+    if (k % 5 == 4) {
+      v = 0.3 * vectors[k - 1] - 1.7 * vectors[k / 2];
+    } else if (k == 33) {
+      v = -2.0 * vectors[10];
+    } else if (k != 41) {
+      for (int e = 0; e < 4; ++e) v[(3 * k + 7 * e + e * e) % dimension] += scrambled(k, e, 0.4);
+    }
+    vectors.push_back(v);
+  }
+  odyn::SparseBasis basis;
+  basis.reset(dimension, odyn::rank_tolerance);
+  Eigen::MatrixXd so_far(dimension, 0);
+  Eigen::Index rank = 0;
+  int dependent = 0;
+  for (std::size_t k = 0; k < vectors.size(); ++k) {
+    std::vector<int> indices;
+    std::vector<double> values;
+    for (int i = 0; i < dimension; ++i)
+      if (vectors[k][i] != 0.0) {
+        indices.push_back(i);
+        values.push_back(vectors[k][i]);
+      }
+    so_far.conservativeResize(Eigen::NoChange, so_far.cols() + 1);
+    so_far.rightCols(1) = vectors[k];
+    const Eigen::Index new_rank = Eigen::FullPivLU<Eigen::MatrixXd>(so_far).rank();
+    INFO("vector " << k);
+    CHECK(basis.add(indices, values) == (new_rank > rank));
+    dependent += new_rank > rank ? 0 : 1;
+    rank = new_rank;
+  }
+  CHECK(basis.rank() == rank);
+  CHECK(dependent > 16);
+}
+
+/// A spherical chain of `links` links of 1 m and 1 kg along x from the origin, a spring-damper
+/// between neighbours if `springs`, gravity along -z.
+ChainModel chain(int links, bool springs) {
+  ChainModel model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < links; ++i) {
+    const odyn::BodyId body =
+        model.add_body({.name = "link" + std::to_string(i),
+                        .mass = 1.0,
+                        .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
+                        .position = {0.5 + i, 0.0, 0.0}});
+    const Vector3d on_previous = previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0);
+    model.add(
+        sp::Spherical("ball" + std::to_string(i), previous, on_previous, body, {-0.5, 0.0, 0.0}));
+    if (springs && !previous.is_ground())
+      model.add(sp::Tsda("spring" + std::to_string(i), previous, Vector3d::Zero(), body,
+                         Vector3d::Zero(),
+                         {.stiffness = 40.0, .damping = 0.5, .free_length = 0.9}));
+    previous = body;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  return model;
+}
+
+/// Every factorization's solve of the Newton matrix at the assembled state, against the dense
+/// LU's; the gyroscopic terms make the damping block unsymmetric.
+template <class Model>
+void check_factorizations(const Model& model, bool coupled) {
+  odyn::Workspace<Model> ws(model);
+  odyn::assemble(model, ws);
+  const Eigen::Index size = model.num_velocities() + model.num_equations();
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(size, -1.0, 1.0);
+  for (const odyn::IterationFactors factors :
+       {odyn::IterationFactors{}, odyn::IterationFactors{1.0, 2.5e-5, 5e-3}}) {
+    odyn::DenseSaddlePoint<Model> dense;
+    dense.analyze(model);
+    REQUIRE(dense.factorize(model, ws, factors));
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(size);
+    dense.solve(rhs, expected);
+    for (const odyn::LinearSolver choice :
+         {odyn::LinearSolver::dense, odyn::LinearSolver::cholmod, odyn::LinearSolver::klu,
+          odyn::LinearSolver::automatic}) {
+      if (coupled && choice == odyn::LinearSolver::cholmod) continue;
+      INFO(odyn::linear_solver_name(choice) << ", stiffness factor " << factors.stiffness);
+      odyn::BlockSchurSaddlePoint<Model> solver;
+      solver.choose(choice);
+      solver.analyze(model);
+      REQUIRE(solver.factorize(model, ws, factors));
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
+      solver.solve(rhs, x);
+      // The Schur paths factorize the symmetric part of A on purpose when it is unsymmetric
+      // (see saddle_point.hpp): compare those only on the symmetric matrix.
+      const bool schur = std::string(solver.path_name()).find("schur") != std::string::npos;
+      if (factors.damping == 0.0 || !schur) CHECK((x - expected).norm() <= 1e-10 * expected.norm());
+    }
+  }
+}
+
+TEST_CASE("Every saddle-point factorization solves what the dense LU solves", "[sparse]") {
+  SECTION("the spatial engine") {
+    engine::Engine e = engine::build();
+    check_factorizations(e.model, false);
+  }
+  SECTION("a chain of 40 links") {
+    check_factorizations(chain(40, false), false);
+  }
+  SECTION("a chain of 40 links with a spring-damper along every link") {
+    check_factorizations(chain(40, true), true);
+  }
+  SECTION("cholmod refuses a model whose force elements couple bodies, by name") {
+    odyn::BlockSchurSaddlePoint<ChainModel> solver;
+    solver.choose(odyn::LinearSolver::cholmod);
+    const ChainModel model = chain(3, true);
+    CHECK_THROWS_WITH(solver.analyze(model), Catch::Contains("choose klu"));
+  }
+  SECTION("automatic choices by size") {
+    odyn::BlockSchurSaddlePoint<ChainModel> solver;
+    solver.analyze(chain(4, false));
+    CHECK(std::string(solver.path_name()) == "dense-schur");
+    solver.analyze(chain(200, false));
+    CHECK(std::string(solver.path_name()) == "cholmod-schur");
+    solver.analyze(chain(200, true));
+    CHECK(std::string(solver.path_name()) == "klu");
+  }
+}
+
+TEST_CASE("The sparse assembly gives the dense assembly's state", "[sparse][assembly]") {
+  // A 30-link chain started off its joints, with velocities given on every link: some
+  // components can be kept, the rest are adjusted; both assemblies must decide alike.
+  ChainModel model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < 30; ++i) {
+    sp::Body link{.name = "link" + std::to_string(i),
+                  .mass = 1.0 + 0.1 * i,
+                  .inertia = sp::Body::principal(0.01, 1.0 / 12.0, 0.09),
+                  .position = {0.5 + 1.01 * i, 0.02 * std::sin(i), -0.01 * i},
+                  .orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * i, Vector3d::UnitZ())),
+                  .linear_velocity = {0.1 * std::cos(i), 0.2, 0.0},
+                  .angular_velocity = {0.0, 0.0, 0.3}};
+    if (i % 3 == 0) link.velocity_given = std::array<bool, 6>{true, true, true, true, true, true};
+    const odyn::BodyId body = model.add_body(link);
+    const Vector3d on_previous = previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0);
+    model.add(
+        sp::Spherical("ball" + std::to_string(i), previous, on_previous, body, {-0.5, 0.0, 0.0}));
+    previous = body;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  odyn::Workspace<ChainModel> dense_ws(model), sparse_ws(model);
+  const auto dense = odyn::assemble(model, dense_ws, {.linear_solver = odyn::LinearSolver::dense});
+  const auto sparse = odyn::assemble(model, sparse_ws, {.linear_solver = odyn::LinearSolver::klu});
+  CHECK(sparse.kept_velocity_components == dense.kept_velocity_components);
+  CHECK(sparse.adjusted_velocity_components == dense.adjusted_velocity_components);
+  CHECK(!dense.adjusted_velocity_components.empty());
+  CHECK(!dense.kept_velocity_components.empty());
+  // The kept components set velocities of up to about 50 m/s: errors are relative to those.
+  // (The dense assembly's rank-revealing QR of the whole matrix leaves a velocity residual of
+  // about 1e-10 here, the sparse LU about 2e-12.)
+  const auto largest = [](const Eigen::VectorXd& x) { return x.cwiseAbs().maxCoeff(); };
+  CHECK(sparse.position_residual <= 1e-12);
+  CHECK(sparse.velocity_residual <= 1e-12 * largest(dense_ws.v));
+  // Both Newton iterations take minimum-norm steps: the same assembled pose.
+  CHECK(largest(sparse_ws.q - dense_ws.q) <= 1e-12);
+  CHECK(largest(sparse_ws.v - dense_ws.v) <= 1e-8 * largest(dense_ws.v));
+  CHECK(largest(sparse_ws.vdot - dense_ws.vdot) <= 1e-8 * largest(dense_ws.vdot));
+  CHECK(largest(sparse_ws.lambda - dense_ws.lambda) <= 1e-8 * largest(dense_ws.lambda));
+}
+
+TEST_CASE("A large model's redundant joint is named, and the model still runs", "[sparse]") {
+  // 100 links (past the dense assembly's size), and a second ball joint repeating the last
+  // one: its three equations repeat the first's.
+  ChainModel model = chain(100, false);
+  model.add(sp::Spherical("repeated", odyn::BodyId{99}, {0.5, 0.0, 0.0}, odyn::BodyId{100},
+                          {-0.5, 0.0, 0.0}));
+  odyn::Workspace<ChainModel> ws(model);
+  odyn::assemble(model, ws);
+  const auto redundant = odyn::redundant_equations(model, ws);
+  REQUIRE(redundant.size() == 3);
+  for (int k = 0; k < 3; ++k) {
+    CHECK(redundant[k].joint == "repeated");
+    CHECK(redundant[k].equation == k);
+  }
+  CHECK_THROWS_WITH(odyn::require_independent_constraints(model, ws),
+                    Catch::Contains("repeated (equation"));
+  odyn::GeneralizedAlpha<ChainModel> integrator(model, ws);
+  for (int k = 0; k < 10; ++k) integrator.step(1e-3);
+  // Free fall of the whole chain's start: the links' centres drop as g t^2 / 2 at first, the
+  // joint keeps the last two together.
+  CHECK(std::abs(ws.q[99 * 7 + 2] - (-0.5 * 9.81 * 0.01 * 0.01)) <= 1e-6);
+  CHECK(ws.phi.cwiseAbs().maxCoeff() <= 1e-10);
+}
+
+TEST_CASE("A hanging chain on the sparse path swings at its analytic frequencies",
+          "[sparse][dynamics]") {
+  // N uniform links (mass m, length l, inertia m l^2 / 12 across) hanging from ball joints.
+  // Minimal coordinates theta_k (link k's angle from the vertical, in the x-z plane); the
+  // Lagrangian's linearization gives M_ij = sum_k m a_ki a_kj + I delta_ij, with a_kj = l
+  // (j < k), l / 2 (j = k), 0 (j > k), and K = diag(m g (l (N - 1 - j) + l / 2)). Each mode
+  // shape, started at rest with a small amplitude, swings at its own frequency.
+  constexpr int links = 6;
+  constexpr double m = 1.0, l = 1.0, g = 9.81, inertia = m * l * l / 12.0;
+  Eigen::MatrixXd mass = inertia * Eigen::MatrixXd::Identity(links, links);
+  Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(links, links);
+  for (int i = 0; i < links; ++i) {
+    stiffness(i, i) = m * g * (l * (links - 1 - i) + 0.5 * l);
+    for (int j = 0; j < links; ++j)
+      for (int k = std::max(i, j); k < links; ++k)
+        mass(i, j) += m * (i < k ? l : 0.5 * l) * (j < k ? l : 0.5 * l);
+  }
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> modes(stiffness, mass);
+  for (const int mode : {0, 2}) {
+    const double omega = std::sqrt(modes.eigenvalues()[mode]);
+    Eigen::VectorXd theta = modes.eigenvectors().col(mode);
+    theta *= 1e-3 / theta.cwiseAbs().maxCoeff();
+    ChainModel model;
+    odyn::BodyId previous = odyn::ground;
+    Vector3d joint = Vector3d::Zero();
+    for (int k = 0; k < links; ++k) {
+      const Vector3d down(std::sin(theta[k]), 0.0, -std::cos(theta[k]));
+      const odyn::BodyId body = model.add_body(
+          {.name = "link" + std::to_string(k),
+           .mass = m,
+           .inertia = sp::Body::principal(inertia, inertia, 1e-4),
+           .position = joint + 0.5 * l * down,
+           .orientation = Eigen::Quaterniond(Eigen::AngleAxisd(-theta[k], Vector3d::UnitY()))});
+      const Vector3d on_previous =
+          previous.is_ground() ? Vector3d::Zero() : Vector3d(0, 0, -0.5 * l);
+      model.add(sp::Spherical("ball" + std::to_string(k), previous, on_previous, body,
+                              {0.0, 0.0, 0.5 * l}));
+      joint += l * down;
+      previous = body;
+    }
+    model.add(sp::Gravity("gravity", {0.0, 0.0, -g}));
+    odyn::Workspace<ChainModel> ws(model);
+    odyn::DynamicsSettings settings;
+    settings.step = 1e-3;
+    settings.output_interval = 1e-3;
+    settings.t_end = 3.2 * 2.0 * std::numbers::pi / omega;
+    settings.generalized_alpha.rho_inf = 1.0;
+    settings.linear_solver = odyn::LinearSolver::cholmod;
+    // The top link's centre crosses x = 0 every half period.
+    std::vector<double> crossings;
+    double last_t = 0.0, last_x = 0.0;
+    odyn::simulate(model, ws, settings, [&](const odyn::Workspace<ChainModel>& w) {
+      const double x = w.q[0];
+      if (w.t > 0.0 && ((last_x > 0.0 && x <= 0.0) || (last_x < 0.0 && x >= 0.0)))
+        crossings.push_back(last_t + (w.t - last_t) * last_x / (last_x - x));
+      last_t = w.t;
+      last_x = x;
+    });
+    INFO("mode " << mode << ", omega " << omega);
+    REQUIRE(crossings.size() >= 5);
+    const double half_period =
+        (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+    CHECK(std::abs(std::numbers::pi / half_period - omega) <= 1e-4 * omega);
+  }
+}
+
+}  // namespace test_sparse
