@@ -71,6 +71,7 @@ TEST_CASE("Sparse Cholesky and sparse LU solve like Eigen's dense factorizations
     cholesky.analyze(a.dimension(), a.column_starts(), a.row_indices());
     REQUIRE(cholesky.factorize(a.values()));
     CHECK(cholesky.reciprocal_condition() > 1e-3);
+    CHECK(cholesky.smallest_pivot_ratio() > 0.5);  // diagonally dominant
     Eigen::VectorXd x = dense * expected;
     cholesky.solve_in_place(x);
     CHECK((x - expected).norm() <= 1e-12 * expected.norm());

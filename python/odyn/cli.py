@@ -41,6 +41,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--coordinates", choices=["absolute", "joint"],
                      help="dopri5 and dop853 on spatial models: step joint coordinates of a "
                      "spanning tree, loops closed by constraints (default: absolute)")
+    run.add_argument("--linear-solver", choices=["auto", "dense", "cholmod", "klu"],
+                     help="factorization of the linear systems: dense for small models, "
+                     "sparse (cholmod, klu) for large ones (default: auto, by size)")
     run.add_argument("--out", help="write the output columns to a .csv or .npz file")
     run.add_argument("--plot", help="draw every output column against t into this image")
     run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
@@ -134,7 +137,7 @@ def _run(args: argparse.Namespace) -> int:
     scene = load(args.scene)
     settings = dict(scene.analysis)
     for key in ("t_end", "step", "output_interval", "integrator", "rho_inf", "rtol", "atol",
-                "max_step", "coordinates"):
+                "max_step", "coordinates", "linear_solver"):
         value = getattr(args, key)
         if value is not None:
             settings[key] = value

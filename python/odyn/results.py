@@ -259,12 +259,18 @@ def _warn_redundant(result: Result) -> None:
             "if you need them."), stacklevel=3)
 
 
-def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 50) -> Result:
+#: The factorizations `linear_solver` may name (see `simulate`).
+LINEAR_SOLVERS = ["auto", "dense", "cholmod", "klu"]
+
+
+def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 50,
+             linear_solver: str = "auto") -> Result:
     """Consistent initial positions, velocities, accelerations and multipliers (one row).
     Redundant constraint equations are listed in `result.redundant_equations` and give a
-    `RedundantConstraintsWarning`."""
-    data = _core.assemble(model._core, {"assembly_tolerance": tolerance,
-                                        "assembly_max_iterations": max_iterations})
+    `RedundantConstraintsWarning`. linear_solver: as in `simulate`."""
+    data = _core.assemble(model._core, {
+        "assembly_tolerance": tolerance, "assembly_max_iterations": max_iterations,
+        "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
     result = Result(data)
     _warn_redundant(result)
@@ -280,7 +286,8 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
              constraint_tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None,
              projection_tolerance: Optional[float] = None,
-             order: Optional[int] = None, coordinates: str = "absolute") -> Result:
+             order: Optional[int] = None, coordinates: str = "absolute",
+             linear_solver: str = "auto") -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
@@ -301,6 +308,13 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     Fewer unknowns, so each step costs less; reactions and outputs are the same as in absolute
     coordinates. Redundant loop closures are refused (absolute coordinates handle them).
 
+    linear_solver: the factorization of the linear systems of the assembly and the steps.
+    "auto" (the default) picks by size and pattern: dense kernels for small models (tens of
+    bodies), sparse ones for large models, whose cost grows linearly on chains and trees:
+    "cholmod" (the Schur complement of the constraints, when no force element joins two moving
+    bodies) or "klu" (the whole matrix, when springs, dampers or bushings join bodies).
+    "dense", "cholmod" and "klu" force one.
+
     The GIL is released during the run (Python callables take it back per call).
     progress(t) is called about every 0.2 s of wall time. Ctrl-C raises `odyn.Interrupted`,
     whose `result` holds the outputs so far; an error during the run gets the partial result
@@ -314,7 +328,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
                          projection_tolerance=projection_tolerance,
                          order=_check_order(order),
                          coordinates=check_choice(coordinates, "coordinates",
-                                                  ["absolute", "joint"]))
+                                                  ["absolute", "joint"]),
+                         linear_solver=check_choice(linear_solver, "linear_solver",
+                                                    LINEAR_SOLVERS))
     data = _core.simulate(model._core, settings, progress)
     error = data.pop("error")
     if error is None:

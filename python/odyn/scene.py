@@ -37,7 +37,7 @@ import numpy as np
 from . import _schema
 from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
 from .model import BaseModel, Model, new_model
-from .results import ADAPTIVE_OPTIONAL, Result, integrators, simulate
+from .results import ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Result, integrators, simulate
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
@@ -52,7 +52,7 @@ ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf
                                      "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
 ANALYSIS_OPTIONAL = ("rtol", "atol", "max_step", "adaptive", "newton_rtol", "newton_atol",
                      "constraint_tolerance", "max_iterations", "projection_tolerance", "order",
-                     "coordinates")
+                     "coordinates", "linear_solver")
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
@@ -169,6 +169,8 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                 out[key] = d[key]
             elif key == "coordinates":
                 out[key] = check_choice(d[key], f"{where}.{key}", ["absolute", "joint"])
+            elif key == "linear_solver":
+                out[key] = check_choice(d[key], f"{where}.{key}", LINEAR_SOLVERS)
             elif key == "order":
                 if not isinstance(d[key], int) or isinstance(d[key], bool) or \
                         not 1 <= d[key] <= 6:

@@ -27,6 +27,7 @@ inline AssemblySettings assembly_settings(const py::dict& d) {
   AssemblySettings s;
   s.tolerance = get(d, "assembly_tolerance", s.tolerance);
   s.max_iterations = get(d, "assembly_max_iterations", s.max_iterations);
+  s.linear_solver = linear_solver_from_name(get(d, "linear_solver", std::string("auto")));
   return s;
 }
 
@@ -37,6 +38,7 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   s.output_interval = get(d, "output_interval", s.output_interval);
   s.integrator = get(d, "integrator", s.integrator);
   s.coordinates = get(d, "coordinates", s.coordinates);
+  s.linear_solver = linear_solver_from_name(get(d, "linear_solver", std::string("auto")));
   s.rtol = get(d, "rtol", s.rtol);
   s.atol = get(d, "atol", s.atol);
   s.max_step = get(d, "max_step", s.max_step);

@@ -34,7 +34,7 @@ struct AssemblySettings {
 };
 
 /// Velocities plus constraint equations up to which `auto` assembles with dense matrices.
-inline constexpr int dense_assembly_limit = 300;
+inline constexpr int dense_assembly_limit = 100;
 
 struct AssemblyReport {
   int iterations = 0;

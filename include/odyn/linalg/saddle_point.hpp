@@ -169,8 +169,16 @@ class BlockSchurSaddlePoint {
   static constexpr int dense_schur_limit = 120;
   static constexpr int dense_kkt_limit = 60;
 
+  /// Largest Newton contraction, estimated body by body as |A_sym^-1 A_skew|, that the Schur
+  /// complement may cost by using the symmetric part of A. Beyond it (slender bodies spinning
+  /// about their thin axis, whose gyroscopic terms outweigh their inertia at the step size)
+  /// Newton would crawl or fail, and that factorization takes the whole matrix instead.
+  static constexpr double max_dropped_skew = 0.25;
+
   void analyze(const Model& model) {
     path_ = choose_path(model);
+    whole_ = Whole::none;
+    whole_dense_analyzed_ = whole_sparse_analyzed_ = false;
     if (path_ == Path::dense_kkt) {
       dense_.analyze(model);
       return;
@@ -252,6 +260,8 @@ class BlockSchurSaddlePoint {
     if (path_ == Path::dense_kkt) return dense_.factorize(model, ws, f);
     if (path_ == Path::sparse_kkt) return sparse_kkt_.factorize(model, ws, f);
     if (!invert_blocks(model, ws, f)) return false;
+    whole_ = Whole::none;
+    if (dropped_skew_ > max_dropped_skew) return factorize_whole(model, ws, f);
     if (path_ == Path::sparse_schur) {
       sparse_schur_.set_zero();
       assemble_schur(ws, sparse_schur_);
@@ -268,10 +278,14 @@ class BlockSchurSaddlePoint {
 
   /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
   int rank_deficiency() const {
-    if (path_ == Path::dense_kkt) return dense_.rank_deficiency();
-    if (path_ == Path::sparse_kkt) return sparse_kkt_.rank_deficiency();
+    if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.rank_deficiency();
+    if (path_ == Path::sparse_kkt || whole_ == Whole::sparse) return sparse_kkt_.rank_deficiency();
     return rank_deficiency_;
   }
+
+  /// |A_sym^-1 A_skew| of the last factorization (largest over the bodies): what the Schur
+  /// paths compare with max_dropped_skew.
+  double dropped_skew() const { return dropped_skew_; }
 
   /// The factorization the last analyze chose: "dense-schur", "cholmod-schur", "dense-lu" or
   /// "klu".
@@ -290,8 +304,9 @@ class BlockSchurSaddlePoint {
 
   /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    if (path_ == Path::dense_kkt) return dense_.solve(rhs, solution);
-    if (path_ == Path::sparse_kkt) return sparse_kkt_.solve(rhs, solution);
+    if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.solve(rhs, solution);
+    if (path_ == Path::sparse_kkt || whole_ == Whole::sparse)
+      return sparse_kkt_.solve(rhs, solution);
     // B A^-1 f = sum over the blocks of W_e f_b.
     work_m_ = -rhs.tail(m_);
     for_each_weighted([&](const BlockRef& ref, const auto& w) {
@@ -334,6 +349,23 @@ class BlockSchurSaddlePoint {
  private:
   enum class Method { cholesky, sparse_cholesky, lu, minimum_norm };
   enum class Path { dense_schur, sparse_schur, dense_kkt, sparse_kkt };
+  /// Which whole-matrix factorization stands in for a Schur path's, if any.
+  enum class Whole { none, dense, sparse };
+
+  /// The whole matrix, for a factorization whose A is too unsymmetric for the Schur
+  /// complement: dense for small models, KLU for large ones, analyzed on first use.
+  bool factorize_whole(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
+    if (n_ + m_ <= dense_kkt_limit && choice_ != LinearSolver::klu) {
+      if (!whole_dense_analyzed_) dense_.analyze(model);
+      whole_dense_analyzed_ = true;
+      whole_ = Whole::dense;
+      return dense_.factorize(model, ws, f);
+    }
+    if (!whole_sparse_analyzed_) sparse_kkt_.analyze(model);
+    whole_sparse_analyzed_ = true;
+    whole_ = Whole::sparse;
+    return sparse_kkt_.factorize(model, ws, f);
+  }
 
   /// What to factorize: the Schur complement needs A block diagonal (no force element's Newton
   /// blocks join two moving bodies).
@@ -451,11 +483,17 @@ class BlockSchurSaddlePoint {
     for (Block& block : blocks_) block.setZero();
     detail::BlockDiagonalView<nv> view{&blocks_};
     add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping);
+    dropped_skew_ = 0.0;
     for (int b = 0; b < bodies_; ++b) {
-      // Gyroscopic damping makes A slightly unsymmetric; Cholesky then needs its symmetric
-      // part, which only slows Newton's convergence a little, never its result.
+      // Gyroscopic damping makes A unsymmetric; Cholesky needs its symmetric part, which
+      // slows Newton's convergence (never its result) by about |A_sym^-1 A_skew| a step.
       inverses_[b] = detail::invert_symmetric<nv>(0.5 * (blocks_[b] + blocks_[b].transpose()));
       if (!inverses_[b].allFinite()) return false;
+      if (!mass_only) {
+        const Block skew = 0.5 * (blocks_[b] - blocks_[b].transpose());
+        dropped_skew_ =
+            std::max(dropped_skew_, (inverses_[b] * skew).cwiseAbs().rowwise().sum().maxCoeff());
+      }
     }
     if (mass_only) {
       cached_mass_factor_ = f.mass;
@@ -464,14 +502,20 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
-  /// Factorizes the sparse S by CHOLMOD. When S is not positive definite or nearly singular
-  /// (A indefinite, or redundant constraints), it goes the dense way below: correct, but
-  /// O(m^3), so large over-constrained models are not on the linear-cost path yet.
+  /// Below this, a pivot of the sparse factorization relative to its diagonal entry of S
+  /// counts as zero: a row that repeats others (rounding, 1e-16 or so). Not rank_tolerance:
+  /// on a chain of slender hinged links the smallest ratio falls as N^-3 in a well-posed
+  /// model (7.5e-9 at 256 links, 1.2e-10 at 1024), and would be taken for a redundancy.
+  static constexpr double singular_pivot_ratio = 1e-13;
+
+  /// Factorizes the sparse S by CHOLMOD. When S is not positive definite or singular (A
+  /// indefinite, or redundant constraints), it goes the dense way below: correct, but O(m^3),
+  /// so large over-constrained models are not on the linear-cost path yet.
   bool factorize_sparse_schur() {
     rank_deficiency_ = 0;
     const std::vector<double>& values = sparse_schur_.gather();
     if (sparse_cholesky_.factorize(values) &&
-        sparse_cholesky_.reciprocal_condition() > rank_tolerance) {
+        sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio) {
       method_ = Method::sparse_cholesky;
       return true;
     }
@@ -516,7 +560,10 @@ class BlockSchurSaddlePoint {
 
   LinearSolver choice_ = LinearSolver::automatic;
   Path path_ = Path::dense_schur;
-  DenseSaddlePoint<Model> dense_;           // path dense_kkt
+  Whole whole_ = Whole::none;  // the last factorization took the whole matrix
+  bool whole_dense_analyzed_ = false, whole_sparse_analyzed_ = false;
+  double dropped_skew_ = 0.0;      // max over the bodies of |A_sym^-1 A_skew| (infinity norm)
+  DenseSaddlePoint<Model> dense_;  // path dense_kkt
   SparseKktSaddlePoint<Model> sparse_kkt_;  // path sparse_kkt
   int bodies_ = 0, n_ = 0, m_ = 0;
   Method method_ = Method::cholesky;

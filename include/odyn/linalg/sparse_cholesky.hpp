@@ -9,7 +9,6 @@
 // L D L^T with AMD ordering, which is slower on large matrices but needs no library.
 
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,6 +17,8 @@
 
 #ifdef ODYN_WITH_SUITESPARSE
 #include <cholmod.h>
+#else
+#include <Eigen/SparseCholesky>
 #endif
 
 namespace odyn {
@@ -58,6 +59,15 @@ class SparseCholesky {
     return impl_->reciprocal_condition();
   }
 
+  /// The smallest pivot relative to its own diagonal entry of A, min_j D_jj / A_jj (D_jj =
+  /// L_jj^2 for an L L^T factor): the part of a row that elimination leaves. It is near
+  /// rounding for a row that depends on the others, and it does not shrink with the spread of
+  /// the rows' scales as the condition number does (a long chain of slender links is well
+  /// posed with a condition number of 1e10 or more).
+  double smallest_pivot_ratio() const {
+    return impl_->smallest_pivot_ratio();
+  }
+
   /// x <- A^-1 x.
   void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) {
     impl_->solve_in_place(x);
@@ -91,6 +101,7 @@ class SparseCholesky {
     std::vector<int> starts, rows;  // the permuted triangle's CSC structure
     std::vector<int> source;        // (entries) which caller value each entry takes
     std::vector<double> values;     // (entries)
+    std::vector<int> diagonal;      // (n) where each column's diagonal entry is in values
     Eigen::VectorXd right_side;     // (n) permuted
     bool factorized = false;
 
@@ -160,6 +171,10 @@ class SparseCholesky {
         source[k] = entries[k].source;
       }
       for (int j = 0; j < n; ++j) starts[j + 1] += starts[j];
+      diagonal.assign(static_cast<std::size_t>(n), -1);
+      for (int j = 0; j < n; ++j)
+        for (int k = starts[j]; k < starts[j + 1]; ++k)
+          if (rows[k] == j) diagonal[j] = k;
       values.assign(entries.size(), 0.0);
       matrix = pattern(n, starts, rows, supernodal ? -1 : 1);
       common.nmethods = 1;
@@ -190,6 +205,38 @@ class SparseCholesky {
 
     double reciprocal_condition() const {
       return cholmod_rcond(factor, const_cast<cholmod_common*>(&common));
+    }
+
+    /// D_jj of column j of the factor (L_jj^2 for L L^T), in the permuted order.
+    template <class F>
+    void for_each_pivot(F&& f) const {
+      const auto* x = static_cast<const double*>(factor->x);
+      if (factor->is_super) {
+        const auto* super = static_cast<const int*>(factor->super);
+        const auto* pi = static_cast<const int*>(factor->pi);
+        const auto* px = static_cast<const int*>(factor->px);
+        for (std::size_t s = 0; s < factor->nsuper; ++s) {
+          const int rows_of_block = pi[s + 1] - pi[s];
+          for (int j = super[s]; j < super[s + 1]; ++j) {
+            const int c = j - super[s];
+            const double l = x[px[s] + c * rows_of_block + c];
+            f(j, l * l);
+          }
+        }
+        return;
+      }
+      const auto* p = static_cast<const int*>(factor->p);
+      for (int j = 0; j < static_cast<int>(factor->n); ++j)
+        f(j, factor->is_ll ? x[p[j]] * x[p[j]] : x[p[j]]);
+    }
+
+    double smallest_pivot_ratio() const {
+      double smallest = std::numeric_limits<double>::infinity();
+      for_each_pivot([&](int j, double pivot) {
+        const double a = diagonal[j] >= 0 ? values[diagonal[j]] : 0.0;
+        smallest = std::min(smallest, a > 0.0 ? pivot / a : 0.0);
+      });
+      return smallest;
     }
 
     void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) {
@@ -251,10 +298,11 @@ class SparseCholesky {
     int n = 0;
     const std::vector<int>* starts = nullptr;
     const std::vector<int>* rows = nullptr;
+    const std::vector<double>* values = nullptr;  // of the last factorize
 
-    Eigen::Map<const Matrix> map(const double* values) const {
+    Eigen::Map<const Matrix> map(const double* x) const {
       return Eigen::Map<const Matrix>(n, n, static_cast<int>(rows->size()), starts->data(),
-                                      rows->data(), values);
+                                      rows->data(), x);
     }
 
     void analyze(int size, const std::vector<int>& column_starts,
@@ -266,8 +314,9 @@ class SparseCholesky {
       ldlt.analyzePattern(map(ones.data()));
     }
 
-    bool factorize(const std::vector<double>& values) {
-      ldlt.factorize(map(values.data()));
+    bool factorize(const std::vector<double>& new_values) {
+      values = &new_values;
+      ldlt.factorize(map(new_values.data()));
       if (ldlt.info() != Eigen::Success) return false;
       const auto d = ldlt.vectorD();
       return n == 0 || (d.minCoeff() > 0.0 && std::isfinite(d.sum()));
@@ -276,6 +325,20 @@ class SparseCholesky {
     double reciprocal_condition() const {
       const auto d = ldlt.vectorD();
       return n == 0 ? 1.0 : d.minCoeff() / d.maxCoeff();
+    }
+
+    double smallest_pivot_ratio() const {
+      // Eigen's D is in its own permuted order: compare with the permuted diagonal of A.
+      const auto d = ldlt.vectorD();
+      const auto& order = ldlt.permutationP().indices();
+      double smallest = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < n; ++j) {
+        double a = 0.0;
+        for (int k = (*starts)[j]; k < (*starts)[j + 1]; ++k)
+          if ((*rows)[k] == j) a = (*values)[k];
+        smallest = std::min(smallest, a > 0.0 ? d[order[j]] / a : 0.0);
+      }
+      return smallest;
     }
 
     void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { x = ldlt.solve(Eigen::VectorXd(x)); }

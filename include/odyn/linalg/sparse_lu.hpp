@@ -9,14 +9,15 @@
 // SparseLU (supernodal, COLAMD ordering) stands in.
 
 #include <Eigen/Core>
-#include <Eigen/OrderingMethods>
-#include <Eigen/SparseLU>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #ifdef ODYN_WITH_SUITESPARSE
 #include <klu.h>
+#else
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseLU>
 #endif
 
 namespace odyn {

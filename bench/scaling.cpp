@@ -1,0 +1,249 @@
+// Scaling report: setup time and time per step against the model's size, on the large models
+// mechanical engineers build (chains, ropes with springs, trees, ladders of closed loops), with
+// generalized-alpha at h = 1e-3 and the default settings (linear_solver auto). Writes one CSV
+// row per case and size and prints a table; bench/plot_scaling.py fits the growth exponents
+// and draws the log-log figure (scripts/scaling.sh runs both, and the peers' script).
+//
+//   scaling [--out FILE.csv] [--min-n N] [--max-n N] [--case NAME]... [--quick]
+//
+// Cases (N bodies):
+//   spherical-chain          N links of 1 m, 1 kg, ball joints, horizontal at the start,
+//                            every link given a velocity (a rigid spin about z): the issue's
+//                            rope;
+//   spherical-chain-springs  the same with a spring-damper between the centres of neighbours
+//                            (the Newton matrix couples the bodies: KLU on the whole matrix);
+//   revolute-chain           hinges about y instead of balls;
+//   binary-tree              a ball-jointed binary tree of links, breadth first;
+//   four-bar-ladder          a column of four-bar loops (a bar hung on two ball-jointed
+//                            links per cell), N / 3 closed loops.
+// setup_s: assembly (positions, the given velocities, accelerations) plus the integrator's
+// analysis, wall time. step_s: the median over 5 blocks of steps of the wall time per step.
+// peak_rss_mb: the process's peak resident memory once the case has run (sizes ascend, so it
+// is the largest model's so far).
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <odyn/odyn.hpp>
+
+namespace {
+
+namespace sp = odyn::spatial;
+using Eigen::Vector3d;
+using Model = sp::Model<sp::Spherical, sp::Revolute, sp::Gravity, sp::Tsda>;
+using Clock = std::chrono::steady_clock;
+constexpr double step = 1e-3;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+/// A link of 1 m and 1 kg along x with its centre at `centre`, spinning rigidly about the
+/// z axis through the origin at 0.1 rad/s (every velocity component given).
+sp::Body link(int index, const Vector3d& centre) {
+  constexpr double spin = 0.1;
+  return {.name = "link" + std::to_string(index),
+          .mass = 1.0,
+          .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
+          .position = centre,
+          .linear_velocity = spin * Vector3d(-centre.y(), centre.x(), 0.0),
+          .angular_velocity = {0.0, 0.0, spin},
+          .velocity_given = std::array<bool, 6>{true, true, true, true, true, true}};
+}
+
+enum class Joint { ball, hinge };
+
+void add_joint(Model& model, Joint joint, const std::string& name, odyn::BodyId a,
+               const Vector3d& on_a, odyn::BodyId b, const Vector3d& on_b) {
+  if (joint == Joint::ball)
+    model.add(sp::Spherical(name, a, on_a, b, on_b));
+  else
+    model.add(sp::Revolute(name, a, sp::JointFrame{on_a, Vector3d::UnitY()}, b,
+                           sp::JointFrame{on_b, Vector3d::UnitY()}));
+}
+
+Model chain(int n, Joint joint, bool springs) {
+  Model model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < n; ++i) {
+    const odyn::BodyId body = model.add_body(link(i, {0.5 + i, 0.0, 0.0}));
+    const Vector3d on_previous = previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0);
+    add_joint(model, joint, "joint" + std::to_string(i), previous, on_previous, body,
+              {-0.5, 0.0, 0.0});
+    if (springs && !previous.is_ground())
+      model.add(sp::Tsda("spring" + std::to_string(i), previous, Vector3d::Zero(), body,
+                         Vector3d::Zero(),
+                         {.stiffness = 100.0, .damping = 1.0, .free_length = 1.0}));
+    previous = body;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  return model;
+}
+
+/// Body k's children are 2k + 1 and 2k + 2 (from 0); each link hangs off its parent's far end,
+/// the two children 0.3 m apart across it, all in the horizontal plane.
+Model binary_tree(int n) {
+  Model model;
+  std::vector<odyn::BodyId> bodies;
+  std::vector<Vector3d> far_end;
+  for (int k = 0; k < n; ++k) {
+    const int parent = (k - 1) / 2;
+    const Vector3d start =
+        k == 0 ? Vector3d(Vector3d::Zero())
+               : Vector3d(far_end[parent] + Vector3d(0.0, k % 2 ? 0.15 : -0.15, 0.0));
+    const odyn::BodyId body = model.add_body(link(k, start + Vector3d(0.5, 0.0, 0.0)));
+    if (k == 0)
+      model.add(sp::Spherical("joint0", odyn::ground, Vector3d::Zero(), body, {-0.5, 0.0, 0.0}));
+    else
+      model.add(sp::Spherical("joint" + std::to_string(k), bodies[parent],
+                              {0.5, k % 2 ? 0.15 : -0.15, 0.0}, body, {-0.5, 0.0, 0.0}));
+    bodies.push_back(body);
+    far_end.push_back(start + Vector3d(1.0, 0.0, 0.0));
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  return model;
+}
+
+/// Cells stacked along x: in each, a bar across y hangs on two links from the previous bar (or
+/// the ground), on ball joints at all four corners: one closed loop a cell, without redundant
+/// equations (four parallel hinges would repeat three equations a loop, and a planar hinge
+/// four-bar in this pose is at a singular point). Each cell swings in and out of its plane and
+/// its parts spin about their own axes. 3 bodies a cell.
+Model four_bar_ladder(int n) {
+  Model model;
+  odyn::BodyId previous = odyn::ground;
+  int index = 0;
+  for (int cell = 0; 3 * cell + 3 <= std::max(n, 3); ++cell) {
+    const double x0 = cell;  // the previous bar's line
+    const odyn::BodyId left = model.add_body(link(index++, {x0 + 0.5, -0.5, 0.0}));
+    const odyn::BodyId right = model.add_body(link(index++, {x0 + 0.5, 0.5, 0.0}));
+    sp::Body bar = link(index++, {x0 + 1.0, 0.0, 0.0});
+    bar.inertia = sp::Body::principal(1.0 / 12.0, 5e-3, 1.0 / 12.0);  // along y
+    const odyn::BodyId across = model.add_body(bar);
+    const std::string c = std::to_string(cell);
+    // The previous bar's ends (or the ground's points) at y = -0.5 and 0.5.
+    add_joint(model, Joint::ball, "left-bottom" + c, previous, {0.0, -0.5, 0.0}, left,
+              {-0.5, 0.0, 0.0});
+    add_joint(model, Joint::ball, "left-top" + c, left, {0.5, 0.0, 0.0}, across, {0.0, -0.5, 0.0});
+    add_joint(model, Joint::ball, "right-bottom" + c, previous, {0.0, 0.5, 0.0}, right,
+              {-0.5, 0.0, 0.0});
+    add_joint(model, Joint::ball, "right-top" + c, right, {0.5, 0.0, 0.0}, across, {0.0, 0.5, 0.0});
+    previous = across;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  return model;
+}
+
+struct Row {
+  std::string name;
+  int bodies = 0, equations = 0;
+  double setup_s = 0.0, assembly_s = 0.0, step_s = 0.0, peak_rss_mb = 0.0;
+  long steps = 0;
+  std::string status = "ok";
+};
+
+Row measure(const std::string& name, const Model& model) {
+  Row row;
+  row.name = name;
+  row.bodies = model.num_bodies();
+  row.equations = model.num_equations();
+  try {
+    odyn::Workspace<Model> ws(model);
+    const auto start = Clock::now();
+    odyn::assemble(model, ws);
+    row.assembly_s = seconds_since(start);
+    odyn::GeneralizedAlpha<Model> integrator(model, ws);
+    row.setup_s = seconds_since(start);
+    // Blocks of at least 20 steps and 30 ms; 5 blocks, the median per step.
+    for (int k = 0; k < 3; ++k) integrator.step(step);
+    int block = 20;
+    std::vector<double> per_step;
+    for (int repeat = 0; repeat < 5; ++repeat) {
+      const auto t0 = Clock::now();
+      for (int k = 0; k < block; ++k) integrator.step(step);
+      const double elapsed = seconds_since(t0);
+      per_step.push_back(elapsed / block);
+      row.steps += block;
+      if (repeat == 0 && elapsed < 0.03)
+        block = std::min(2000, static_cast<int>(block * 0.03 / elapsed) + 1);
+    }
+    std::sort(per_step.begin(), per_step.end());
+    row.step_s = per_step[per_step.size() / 2];
+    if (!ws.q.allFinite()) row.status = "non-finite state";
+  } catch (const std::exception& e) {
+    row.status = std::string("failed: ") + e.what();
+    std::replace(row.status.begin(), row.status.end(), ',', ';');
+  }
+  row.peak_rss_mb = peak_rss_mb();
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out = "scaling.csv";
+  int min_n = 1, max_n = 4096;
+  std::vector<std::string> only;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (arg == "--min-n" && i + 1 < argc)
+      min_n = std::atoi(argv[++i]);
+    else if (arg == "--max-n" && i + 1 < argc)
+      max_n = std::atoi(argv[++i]);
+    else if (arg == "--case" && i + 1 < argc)
+      only.emplace_back(argv[++i]);
+    else if (arg == "--quick")
+      max_n = 64;
+    else {
+      std::fprintf(
+          stderr,
+          "usage: scaling [--out FILE.csv] [--min-n N] [--max-n N] [--case NAME]... [--quick]\n");
+      return 2;
+    }
+  }
+  const std::vector<std::pair<std::string, std::function<Model(int)>>> cases = {
+      {"spherical-chain", [](int n) { return chain(n, Joint::ball, false); }},
+      {"spherical-chain-springs", [](int n) { return chain(n, Joint::ball, true); }},
+      {"revolute-chain", [](int n) { return chain(n, Joint::hinge, false); }},
+      {"binary-tree", [](int n) { return binary_tree(n); }},
+      {"four-bar-ladder", [](int n) { return four_bar_ladder(n); }},
+  };
+  std::ofstream csv(out);
+  csv << "case,N,equations,setup_s,assembly_s,step_s,steps,peak_rss_mb,status\n";
+  std::printf("%-24s %6s %7s %10s %10s %10s %8s  %s\n", "case", "N", "eqs", "setup ms", "assem ms",
+              "step ms", "RSS MB", "status");
+  for (const auto& [name, build] : cases) {
+    if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
+    for (int n = 1; n <= max_n; n *= 2) {
+      if (n < min_n) continue;
+      if (name == "four-bar-ladder" && n < 3) continue;
+      const Model model = build(name == "four-bar-ladder" ? 3 * std::max(1, n / 3) : n);
+      const Row row = measure(name, model);
+      csv << row.name << ',' << row.bodies << ',' << row.equations << ',' << row.setup_s << ','
+          << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.peak_rss_mb
+          << ',' << row.status << '\n';
+      csv.flush();
+      std::printf("%-24s %6d %7d %10.3f %10.3f %10.4f %8.0f  %s\n", row.name.c_str(), row.bodies,
+                  row.equations, 1e3 * row.setup_s, 1e3 * row.assembly_s, 1e3 * row.step_s,
+                  row.peak_rss_mb, row.status.c_str());
+      std::fflush(stdout);
+    }
+  }
+}

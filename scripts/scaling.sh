@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Scaling report: builds bench/scaling, runs it (odyn's chains, ropes with springs, trees and
+# ladders of loops, N = 1 ... 4096, and the spherical chain to 16384 for memory), runs the
+# peers' script (Exudyn, MuJoCo and Pinocchio from PyPI in build/peer-venv) in the same run,
+# and writes bench/results/scaling.{csv,md,png} and bench/results/peer_scaling.csv.
+# Extra arguments go to the peers' script (for example --engines exudyn).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+bash scripts/setup.sh --no-package
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
+gen=(-G Ninja)
+[[ -f build/CMakeCache.txt ]] && gen=()
+cmake -S . -B build "${gen[@]}" -DCMAKE_BUILD_TYPE=Release -DODYN_BUILD_BENCH=ON
+cmake --build build --target scaling -j "$(nproc)"
+mkdir -p bench/results
+./build/bench/scaling --out bench/results/scaling.csv
+./build/bench/scaling --case spherical-chain --min-n 8192 --max-n 16384 \
+  --out bench/results/scaling_16384.csv
+tail -n +2 bench/results/scaling_16384.csv >> bench/results/scaling.csv
+rm bench/results/scaling_16384.csv
+python3 bench/peer_scaling.py "$@"
+.venv/bin/python bench/plot_scaling.py
