@@ -7,7 +7,7 @@ import argparse
 import os
 import sys
 import time
-from typing import List, NoReturn, Optional
+from typing import List, NoReturn, Optional, Tuple
 
 import numpy as np
 
@@ -57,20 +57,28 @@ def _parser() -> argparse.ArgumentParser:
 
 
 class _Progress:
-    """A progress bar on stderr, shown only on a terminal and once a run has lasted 1 s."""
+    """A progress bar on stderr, shown only on a terminal and once a run has lasted 1 s. The
+    time left is extrapolated from the stepping so far, not from the setup (assembly and the
+    integrator's analysis), which comes before the first call."""
 
     def __init__(self, t_end: float, enabled: bool) -> None:
         self.t_end, self.enabled, self.start, self.shown = t_end, enabled, time.monotonic(), False
+        self.stepping_from: Optional[Tuple[float, float]] = None  # (wall time, fraction)
 
     def __call__(self, t: float) -> None:
-        elapsed = time.monotonic() - self.start
+        now = time.monotonic()
+        fraction = min(1.0, t / self.t_end) if self.t_end > 0 else 1.0
+        if self.stepping_from is None:
+            self.stepping_from = (now, fraction)
+        elapsed = now - self.start
         if not self.enabled or elapsed < 1.0:
             return
-        fraction = min(1.0, t / self.t_end) if self.t_end > 0 else 1.0
         bar = "#" * int(30 * fraction)
-        eta = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        wall0, fraction0 = self.stepping_from
+        left = (f"left ~{(now - wall0) * (1.0 - fraction) / (fraction - fraction0):.1f} s"
+                if fraction > fraction0 else "left: estimating")
         sys.stderr.write(f"\r[{bar:<30}] {100 * fraction:5.1f}%  t = {t:.4g} s  "
-                         f"elapsed {elapsed:.1f} s, left ~{eta:.1f} s ")
+                         f"elapsed {elapsed:.1f} s (setup {wall0 - self.start:.1f} s), {left} ")
         sys.stderr.flush()
         self.shown = True
 
@@ -112,8 +120,9 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
                      f"factorizations {s['factorizations']}")
         lines.append(f"  largest local error estimate {s['max_error_estimate']:.3g} "
                      "(in units of rtol, atol)")
-        lines.append(f"  wall time {s['wall_seconds']:.3f} s "
-                     f"({1e6 * s['wall_seconds'] / max(steps, 1):.2f} us per step)")
+        stepping = s["wall_seconds"] - s["setup_seconds"]
+        lines.append(f"  wall time {s['wall_seconds']:.3f} s: setup {s['setup_seconds']:.3f} s, "
+                     f"steps {stepping:.3f} s ({1e6 * stepping / max(steps, 1):.2f} us per step)")
     else:
         lines.append(f"  stopped at t = {result.t[-1] if len(result) else 0.0:g} s "
                      f"after {wall:.3f} s")

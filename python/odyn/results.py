@@ -57,7 +57,8 @@ class Statistics(NamedTuple):
     events: int                 # located switches of force laws
     max_error_estimate: float   # largest local error estimate of a step, in units of rtol/atol
     outputs: int
-    wall_seconds: float
+    wall_seconds: float         # the whole run
+    setup_seconds: float        # of which assembly and the integrator's setup
     max_position_residual: float  # max |Phi| at the output times
     max_velocity_residual: float  # max |Phi_q v + Phi_t| at the output times
 

@@ -242,6 +242,7 @@ inline py::dict run_summary(const RunSummary& s) {
   d["max_error_estimate"] = st.max_error_estimate;
   d["outputs"] = s.outputs;
   d["wall_seconds"] = s.wall_seconds;
+  d["setup_seconds"] = s.setup_seconds;
   d["max_position_residual"] = s.max_position_residual;
   d["max_velocity_residual"] = s.max_velocity_residual;
   py::dict assembly = assembly_report(s.assembly);

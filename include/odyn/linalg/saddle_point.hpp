@@ -477,13 +477,13 @@ class BlockSchurSaddlePoint {
   /// assembly) A is a multiple of the constant mass matrix: its inverses are kept and reused.
   bool invert_blocks(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     const bool mass_only = f.stiffness == 0.0 && f.damping == 0.0;
+    dropped_skew_ = 0.0;  // M is symmetric
     if (mass_only && f.mass == cached_mass_factor_) return true;
     cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
     std::fill(diagonal_inverse_.begin(), diagonal_inverse_.end(), false);
     for (Block& block : blocks_) block.setZero();
     detail::BlockDiagonalView<nv> view{&blocks_};
     add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping);
-    dropped_skew_ = 0.0;
     for (int b = 0; b < bodies_; ++b) {
       // Gyroscopic damping makes A unsymmetric; Cholesky needs its symmetric part, which
       // slows Newton's convergence (never its result) by about |A_sym^-1 A_skew| a step.
