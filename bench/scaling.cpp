@@ -7,9 +7,10 @@
 //   scaling [--out FILE.csv] [--min-n N] [--max-n N] [--case NAME]... [--quick]
 //
 // Cases (N bodies):
-//   spherical-chain          N links of 1 m, 1 kg, ball joints, horizontal at the start,
-//                            every link given a velocity (a rigid spin about z): the issue's
-//                            rope;
+//   spherical-chain          N links of 1 m, 1 kg, ball joints, horizontal and at rest at the
+//                            start: the rope;
+//   spherical-chain-moving   the same with a velocity given on every link (0.1 m/s across):
+//                            the assembly keeps what the joints allow;
 //   spherical-chain-springs  the same with a spring-damper between the centres of neighbours
 //                            (the Newton matrix couples the bodies: KLU on the whole matrix);
 //   revolute-chain           hinges about y instead of balls;
@@ -53,17 +54,19 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
-/// A link of 1 m and 1 kg along x with its centre at `centre`, spinning rigidly about the
-/// z axis through the origin at 0.1 rad/s (every velocity component given).
-sp::Body link(int index, const Vector3d& centre) {
-  constexpr double spin = 0.1;
-  return {.name = "link" + std::to_string(index),
-          .mass = 1.0,
-          .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-          .position = centre,
-          .linear_velocity = spin * Vector3d(-centre.y(), centre.x(), 0.0),
-          .angular_velocity = {0.0, 0.0, spin},
-          .velocity_given = std::array<bool, 6>{true, true, true, true, true, true}};
+/// A link of 1 m and 1 kg along x with its centre at `centre`; if `moving`, given a velocity
+/// of 0.1 m/s across the chain (every component given; the assembly keeps what the joints
+/// allow), else at rest.
+sp::Body link(int index, const Vector3d& centre, bool moving = false) {
+  sp::Body body{.name = "link" + std::to_string(index),
+                .mass = 1.0,
+                .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
+                .position = centre};
+  if (moving) {
+    body.linear_velocity = {0.0, 0.1, 0.0};
+    body.velocity_given = std::array<bool, 6>{true, true, true, true, true, true};
+  }
+  return body;
 }
 
 enum class Joint { ball, hinge };
@@ -77,11 +80,11 @@ void add_joint(Model& model, Joint joint, const std::string& name, odyn::BodyId 
                            sp::JointFrame{on_b, Vector3d::UnitY()}));
 }
 
-Model chain(int n, Joint joint, bool springs) {
+Model chain(int n, Joint joint, bool springs, bool moving = false) {
   Model model;
   odyn::BodyId previous = odyn::ground;
   for (int i = 0; i < n; ++i) {
-    const odyn::BodyId body = model.add_body(link(i, {0.5 + i, 0.0, 0.0}));
+    const odyn::BodyId body = model.add_body(link(i, {0.5 + i, 0.0, 0.0}, moving));
     const Vector3d on_previous = previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0);
     add_joint(model, joint, "joint" + std::to_string(i), previous, on_previous, body,
               {-0.5, 0.0, 0.0});
@@ -154,8 +157,15 @@ struct Row {
   int bodies = 0, equations = 0;
   double setup_s = 0.0, assembly_s = 0.0, step_s = 0.0, peak_rss_mb = 0.0;
   long steps = 0;
+  double newton_per_step = 0.0, factorizations_per_step = 0.0;
   std::string status = "ok";
 };
+
+void newton_per_step_of(Row& row, const odyn::IntegratorStatistics& statistics) {
+  const double steps = static_cast<double>(std::max(1L, statistics.steps));
+  row.newton_per_step = static_cast<double>(statistics.newton_iterations) / steps;
+  row.factorizations_per_step = static_cast<double>(statistics.factorizations) / steps;
+}
 
 Row measure(const std::string& name, const Model& model) {
   Row row;
@@ -182,6 +192,8 @@ Row measure(const std::string& name, const Model& model) {
       if (repeat == 0 && elapsed < 0.03)
         block = std::min(2000, static_cast<int>(block * 0.03 / elapsed) + 1);
     }
+    const auto& statistics = integrator.statistics();
+    newton_per_step_of(row, statistics);
     std::sort(per_step.begin(), per_step.end());
     row.step_s = per_step[per_step.size() / 2];
     if (!ws.q.allFinite()) row.status = "non-finite state";
@@ -220,15 +232,17 @@ int main(int argc, char** argv) {
   }
   const std::vector<std::pair<std::string, std::function<Model(int)>>> cases = {
       {"spherical-chain", [](int n) { return chain(n, Joint::ball, false); }},
+      {"spherical-chain-moving", [](int n) { return chain(n, Joint::ball, false, true); }},
       {"spherical-chain-springs", [](int n) { return chain(n, Joint::ball, true); }},
       {"revolute-chain", [](int n) { return chain(n, Joint::hinge, false); }},
       {"binary-tree", [](int n) { return binary_tree(n); }},
       {"four-bar-ladder", [](int n) { return four_bar_ladder(n); }},
   };
   std::ofstream csv(out);
-  csv << "case,N,equations,setup_s,assembly_s,step_s,steps,peak_rss_mb,status\n";
-  std::printf("%-24s %6s %7s %10s %10s %10s %8s  %s\n", "case", "N", "eqs", "setup ms", "assem ms",
-              "step ms", "RSS MB", "status");
+  csv << "case,N,equations,setup_s,assembly_s,step_s,steps,newton_per_step,"
+         "factorizations_per_step,peak_rss_mb,status\n";
+  std::printf("%-24s %6s %7s %10s %10s %10s %6s %6s %8s  %s\n", "case", "N", "eqs", "setup ms",
+              "assem ms", "step ms", "newton", "facts", "RSS MB", "status");
   for (const auto& [name, build] : cases) {
     if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
     for (int n = 1; n <= max_n; n *= 2) {
@@ -237,11 +251,13 @@ int main(int argc, char** argv) {
       const Model model = build(name == "four-bar-ladder" ? 3 * std::max(1, n / 3) : n);
       const Row row = measure(name, model);
       csv << row.name << ',' << row.bodies << ',' << row.equations << ',' << row.setup_s << ','
-          << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.peak_rss_mb
-          << ',' << row.status << '\n';
+          << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.newton_per_step
+          << ',' << row.factorizations_per_step << ',' << row.peak_rss_mb << ',' << row.status
+          << '\n';
       csv.flush();
-      std::printf("%-24s %6d %7d %10.3f %10.3f %10.4f %8.0f  %s\n", row.name.c_str(), row.bodies,
-                  row.equations, 1e3 * row.setup_s, 1e3 * row.assembly_s, 1e3 * row.step_s,
+      std::printf("%-24s %6d %7d %10.3f %10.3f %10.4f %6.2f %6.2f %8.0f  %s\n", row.name.c_str(),
+                  row.bodies, row.equations, 1e3 * row.setup_s, 1e3 * row.assembly_s,
+                  1e3 * row.step_s, row.newton_per_step, row.factorizations_per_step,
                   row.peak_rss_mb, row.status.c_str());
       std::fflush(stdout);
     }

@@ -470,7 +470,7 @@ class GeneralizedAlpha {
   }
 
   struct NewtonTolerance {
-    double ordinary;  // atol + rtol max|v|, from the settings
+    double ordinary;  // atol + rtol max|v|, from the settings (or a few times the rounding)
     double tight;     // no larger: what the step's own accuracy asks for
   };
 
@@ -483,13 +483,10 @@ class GeneralizedAlpha {
   /// short of it; the iteration then settles for the ordinary tolerance (see solve_step).
   NewtonTolerance newton_tolerance() const {
     const double largest_velocity = ws_.v.cwiseAbs().maxCoeff();
-    const double ordinary = settings_.newton_atol + settings_.newton_rtol * largest_velocity;
-    if (!(previous_local_error_ > 0.0) || !(previous_step_ > 0.0)) return {ordinary, ordinary};
-    constexpr double fraction = 1e-4;
-    const double ratio = h_ / previous_step_;
-    const double following = fraction * previous_local_error_ * ratio * ratio * ratio / h_;
     // Rounding in v, and in Phi (whose terms are about as large as the bodies' positions),
-    // divided by h to turn it into velocity.
+    // divided by h to turn it into velocity. Far from the origin (a rope of 2 km) it exceeds
+    // the settings' tolerance, which then cannot be met: the ordinary tolerance is never
+    // below a few times the rounding.
     double largest_position = 0.0;
     for (int b = 0; b < model_.num_bodies(); ++b)
       largest_position =
@@ -497,6 +494,12 @@ class GeneralizedAlpha {
                    ws_.q.template segment<Model::Space::dim>(b * nq).cwiseAbs().maxCoeff());
     const double rounding =
         std::numeric_limits<double>::epsilon() * (largest_velocity + largest_position / h_);
+    const double ordinary =
+        std::max(settings_.newton_atol + settings_.newton_rtol * largest_velocity, 4.0 * rounding);
+    if (!(previous_local_error_ > 0.0) || !(previous_step_ > 0.0)) return {ordinary, ordinary};
+    constexpr double fraction = 1e-4;
+    const double ratio = h_ / previous_step_;
+    const double following = fraction * previous_local_error_ * ratio * ratio * ratio / h_;
     return {ordinary, std::min(ordinary, std::max(following, rounding))};
   }
 
