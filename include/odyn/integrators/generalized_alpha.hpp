@@ -510,9 +510,13 @@ class GeneralizedAlpha {
              " returned NaN or infinity. Check its parameters and inputs.";
     return "Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
            " iterations (" + diagnosis::worst_constraint(model_, ws_) +
-           diagnosis::strongest_force(model_, ws_) +
-           "). Reduce the step size, check the force elements' parameters, or look for a locked or "
-           "singular mechanism.";
+           diagnosis::strongest_force(model_, ws_) + "). " +
+           (settings_.adaptive
+                ? std::string("Tighten rtol/atol or lower max_step, ")
+                : "Reduce the step size (h = " + to_text(h_) +
+                      " s) or let error control choose it (adaptive = true; in Python and on "
+                      "the command line, give rtol/atol), ") +
+           "check the force elements' parameters, or look for a locked or singular mechanism.";
   }
 
   const Model& model_;

@@ -68,6 +68,10 @@ namespace odyn {
 template <class Model>
 class DenseSaddlePoint {
  public:
+  /// This solver was chosen at compile time (an integrator's Solver parameter): the run-time
+  /// setting does not apply to it.
+  void choose(LinearSolver) {}
+
   void analyze(const Model& model) {
     n_ = model.num_velocities();
     const int size = n_ + model.num_equations();
