@@ -15,9 +15,11 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cassert>
-#include <numeric>
 #include <stdexcept>
+#include <utility>
 #include <vector>
+
+#include "odyn/linalg/compressed_columns.hpp"
 
 namespace odyn {
 
@@ -56,32 +58,19 @@ class BlockSparseMatrix {
   /// triangle. Allocates; nothing after it does.
   void finalize(Triangle triangle) {
     triangle_ = triangle;
-    // One entry per stored number that enters the structure: (column, row, source).
-    struct Entry {
-      int col, row, source;
-    };
-    std::vector<Entry> entries;
+    // One entry per stored number that enters the structure.
+    std::vector<SparseEntry> entries;
     for (const Block& b : blocks_)
       for (int j = 0; j < b.cols; ++j)
         for (int i = 0; i < b.rows; ++i)
           if (triangle == Triangle::full || b.row + i >= b.col + j)
-            entries.push_back(Entry{b.col + j, b.row + i, b.offset + j * b.rows + i});
-    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-      return a.col != b.col ? a.col < b.col : a.row < b.row;
-    });
-    for (std::size_t k = 1; k < entries.size(); ++k)
-      if (entries[k].col == entries[k - 1].col && entries[k].row == entries[k - 1].row)
-        throw std::logic_error("BlockSparseMatrix: two blocks overlap");
-    column_starts_.assign(static_cast<std::size_t>(dimension_) + 1, 0);
-    row_indices_.resize(entries.size());
-    sources_.resize(entries.size());
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-      ++column_starts_[static_cast<std::size_t>(entries[k].col) + 1];
-      row_indices_[k] = entries[k].row;
-      sources_[k] = entries[k].source;
-    }
-    std::partial_sum(column_starts_.begin(), column_starts_.end(), column_starts_.begin());
-    values_.assign(entries.size(), 0.0);
+            entries.push_back(SparseEntry{b.col + j, b.row + i, b.offset + j * b.rows + i});
+    CompressedColumns csc = compress_columns(std::move(entries), dimension_);
+    if (csc.has_duplicates) throw std::logic_error("BlockSparseMatrix: two blocks overlap");
+    column_starts_ = std::move(csc.starts);
+    row_indices_ = std::move(csc.rows);
+    sources_ = std::move(csc.sources);
+    values_.assign(row_indices_.size(), 0.0);
     finalized_ = true;
   }
 

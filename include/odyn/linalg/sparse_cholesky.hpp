@@ -17,6 +17,10 @@
 
 #ifdef ODYN_WITH_SUITESPARSE
 #include <cholmod.h>
+
+#include <utility>
+
+#include "odyn/linalg/compressed_columns.hpp"
 #else
 #include <Eigen/SparseCholesky>
 #endif
@@ -148,34 +152,23 @@ class SparseCholesky {
       std::vector<int> position(static_cast<std::size_t>(n));
       for (int k = 0; k < n; ++k) position[permutation[k]] = k;
       // The permuted entries, in the triangle the factorization reads.
-      struct Entry {
-        int col, row, source;
-      };
-      std::vector<Entry> entries;
+      std::vector<SparseEntry> entries;
       entries.reserve(lower_rows.size());
       for (int j = 0; j < n; ++j)
         for (int k = lower_starts[j]; k < lower_starts[j + 1]; ++k) {
           const int a = position[lower_rows[k]], b = position[j];
           const int low = std::min(a, b), high = std::max(a, b);
-          entries.push_back(supernodal ? Entry{low, high, k} : Entry{high, low, k});
+          entries.push_back(supernodal ? SparseEntry{low, high, k} : SparseEntry{high, low, k});
         }
-      std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
-        return x.col != y.col ? x.col < y.col : x.row < y.row;
-      });
-      starts.assign(static_cast<std::size_t>(n) + 1, 0);
-      rows.resize(entries.size());
-      source.resize(entries.size());
-      for (std::size_t k = 0; k < entries.size(); ++k) {
-        ++starts[static_cast<std::size_t>(entries[k].col) + 1];
-        rows[k] = entries[k].row;
-        source[k] = entries[k].source;
-      }
-      for (int j = 0; j < n; ++j) starts[j + 1] += starts[j];
+      CompressedColumns csc = compress_columns(std::move(entries), n);
+      starts = std::move(csc.starts);
+      rows = std::move(csc.rows);
+      source = std::move(csc.sources);
       diagonal.assign(static_cast<std::size_t>(n), -1);
       for (int j = 0; j < n; ++j)
         for (int k = starts[j]; k < starts[j + 1]; ++k)
           if (rows[k] == j) diagonal[j] = k;
-      values.assign(entries.size(), 0.0);
+      values.assign(rows.size(), 0.0);
       matrix = pattern(n, starts, rows, supernodal ? -1 : 1);
       common.nmethods = 1;
       common.method[0].ordering = CHOLMOD_NATURAL;
