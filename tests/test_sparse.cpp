@@ -133,6 +133,12 @@ TEST_CASE("Sparse Cholesky and sparse LU solve like Eigen's dense factorizations
       CHECK((x - expected).norm() <= 1e-10 * expected.norm());
       CHECK((x - dense.fullPivLu().solve(dense * expected)).norm() <= 1e-10 * expected.norm());
     }
+#ifdef ODYN_WITH_SUITESPARSE
+    // The same values again: KLU keeps its pivots (klu_refactor), it does not choose them anew.
+    const long pivoting = lu.pivoting_factorizations();
+    REQUIRE(lu.factorize(a.values()));
+    CHECK(lu.pivoting_factorizations() == pivoting);
+#endif
     // Column 4 = column 1: singular.
     for (int id = 0; id < a.num_blocks(); ++id) a.block(id).setZero();
     for (int i = 0; i < blocks; ++i) a.block<3, 3>(3 * i, 3 * i).setIdentity();

@@ -171,11 +171,10 @@ void assemble_velocities_and_accelerations_sparse(const Model& model, Workspace<
       if (components[k]) given.push_back((b - 1) * nv + k);
   }
   const std::vector<char> keep = keepable_components(rows, use, given);
-  std::vector<int> kept;
   for (std::size_t k = 0; k < given.size(); ++k)
     (keep[k] ? report.kept_velocity_components : report.adjusted_velocity_components)
         .push_back(given[k]);
-  kept = report.kept_velocity_components;
+  const std::vector<int>& kept = report.kept_velocity_components;
   // min (v - v_user)^T M (v - v_user) subject to Phi_q v = -Phi_t and the kept components.
   Eigen::VectorXd velocity_residual(m);
   jacobian_times(model, ws, user_velocity, velocity_residual);
@@ -192,16 +191,15 @@ void assemble_velocities_and_accelerations_sparse(const Model& model, Workspace<
   jacobian_times(model, ws, ws.v, velocity_residual);
   report.velocity_residual = m > 0 ? (velocity_residual + ws.phi_t).cwiseAbs().maxCoeff() : 0.0;
 
-  // Accelerations and multipliers.
+  // Accelerations and multipliers, with the same Phi_q (the positions have not moved).
   initialize_states(model, ws);
   evaluate_forces(model, ws);
   evaluate_gamma(model, ws);
-  const SparseRows moved = sparse_jacobian(model, ws);
   g.resize(independent);
   for (int r = 0, k = 0; r < m; ++r)
     if (use[r]) g[k++] = ws.gamma[r];
   Eigen::VectorXd vdot;
-  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), moved, use, {}, ws.force, g, vdot,
+  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), rows, use, {}, ws.force, g, vdot,
                                      multipliers))
     throw AssemblyError("assembly", "the mass-constraint matrix is singular (sparse assembly)");
   ws.vdot = vdot;

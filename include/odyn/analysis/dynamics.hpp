@@ -58,8 +58,8 @@ struct RunSummary {
   IntegratorStatistics statistics;
   AssemblyReport assembly;
   long outputs = 0;
-  double wall_seconds = 0.0;   // the whole run
-  double setup_seconds = 0.0;  // of which assembly and the integrator's setup
+  double wall_seconds = 0.0;           // the whole run
+  double setup_seconds = 0.0;          // of which assembly and the integrator's setup
   double max_position_residual = 0.0;  // max |Phi| at the output times
   double max_velocity_residual = 0.0;  // max |Phi_q v + Phi_t| at the output times
   /// Constraint equations that repeat others at the assembled pose (Phi_q rank-deficient): the

@@ -167,9 +167,9 @@ class BlockSchurSaddlePoint {
   void choose(LinearSolver solver) { choice_ = solver; }
 
   /// Sizes below which `automatic` keeps the dense factorizations: constraint equations for the
-  /// Schur complement, unknowns for the whole matrix. Measured on spherical chains (bench/
-  /// bench_scaling.cpp): the dense kernels win on the engine-sized models they were tuned for,
-  /// the sparse ones from a few dozen bodies on.
+  /// Schur complement, unknowns for the whole matrix. Chosen, not measured as crossovers: the
+  /// engine-sized models keep the dense kernels they were tuned for, and on the scaling chains
+  /// (bench/scaling.cpp) the sparse paths run in about linear time from some 40 bodies on.
   static constexpr int dense_schur_limit = 120;
   static constexpr int dense_kkt_limit = 60;
 

@@ -35,15 +35,6 @@ class SparseCholesky {
   SparseCholesky(SparseCholesky&&) noexcept = default;
   SparseCholesky& operator=(SparseCholesky&&) noexcept = default;
 
-  /// The backend's name, for reports.
-  static constexpr const char* backend() {
-#ifdef ODYN_WITH_SUITESPARSE
-    return "cholmod";
-#else
-    return "eigen-simplicial-ldlt";
-#endif
-  }
-
   /// Learns the pattern: n x n, the lower triangle in CSC arrays (which must outlive this
   /// object's use, and keep their values' positions). Allocates.
   void analyze(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
@@ -53,40 +44,25 @@ class SparseCholesky {
 
   /// Factorizes the matrix with these values (in the analyzed pattern's order). False if the
   /// matrix is not positive definite to working precision, or holds non-finite values.
-  bool factorize(const std::vector<double>& values) {
-    return impl_->factorize(values);
-  }
+  bool factorize(const std::vector<double>& values) { return impl_->factorize(values); }
 
   /// An estimate of the reciprocal condition number from the factor's diagonal:
   /// (min L_ii / max L_ii)^2. Small values flag a nearly singular matrix.
-  double reciprocal_condition() const {
-    return impl_->reciprocal_condition();
-  }
+  double reciprocal_condition() const { return impl_->reciprocal_condition(); }
 
   /// The smallest pivot relative to its own diagonal entry of A, min_j D_jj / A_jj (D_jj =
   /// L_jj^2 for an L L^T factor): the part of a row that elimination leaves. It is near
   /// rounding for a row that depends on the others, and it does not shrink with the spread of
   /// the rows' scales as the condition number does (a long chain of slender links is well
   /// posed with a condition number of 1e10 or more).
-  double smallest_pivot_ratio() const {
-    return impl_->smallest_pivot_ratio();
-  }
+  double smallest_pivot_ratio() const { return impl_->smallest_pivot_ratio(); }
 
   /// x <- A^-1 x.
-  void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) {
-    impl_->solve_in_place(x);
-  }
-
-  /// Entries of the factor L (for reports of the fill).
-  double factor_entries() const {
-    return impl_->factor_entries();
-  }
+  void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { impl_->solve_in_place(x); }
 
   /// Whether the factor is supernodal (CHOLMOD's choice for matrices with much fill) rather
   /// than simplicial.
-  bool supernodal() const {
-    return impl_->supernodal();
-  }
+  bool supernodal() const { return impl_->supernodal(); }
 
  private:
 #ifdef ODYN_WITH_SUITESPARSE
@@ -186,12 +162,8 @@ class SparseCholesky {
                    common.status == CHOLMOD_OK && factor->minor == factor->n;
       // A simplicial L D L^T goes through negative pivots: positive definiteness is checked on
       // D here. (A supernodal L L^T stops at the first non-positive pivot by itself.)
-      if (factorized && !factor->is_super && !factor->is_ll) {
-        const auto* column_starts = static_cast<const int*>(factor->p);
-        const auto* entries = static_cast<const double*>(factor->x);
-        for (std::size_t j = 0; j < factor->n && factorized; ++j)
-          factorized = entries[column_starts[j]] > 0.0;
-      }
+      if (factorized && !factor->is_super && !factor->is_ll)
+        for_each_pivot([&](int, double pivot) { factorized = factorized && pivot > 0.0; });
       if (factorized) factorized = std::isfinite(reciprocal_condition());
       return factorized;
     }
@@ -277,12 +249,6 @@ class SparseCholesky {
     }
 
     bool supernodal() const { return factor != nullptr && factor->is_super; }
-
-    double factor_entries() const {
-      if (factor == nullptr) return 0.0;
-      if (factor->is_super) return static_cast<double>(factor->xsize);
-      return static_cast<double>(factor->nzmax);
-    }
   };
 #else
   struct Impl {
@@ -337,10 +303,6 @@ class SparseCholesky {
     void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { x = ldlt.solve(Eigen::VectorXd(x)); }
 
     bool supernodal() const { return false; }
-
-    double factor_entries() const {
-      return static_cast<double>(ldlt.matrixL().nestedExpression().nonZeros());
-    }
   };
 #endif
   std::unique_ptr<Impl> impl_;

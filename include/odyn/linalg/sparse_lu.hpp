@@ -30,14 +30,6 @@ class SparseLu {
   SparseLu(SparseLu&&) noexcept = default;
   SparseLu& operator=(SparseLu&&) noexcept = default;
 
-  static constexpr const char* backend() {
-#ifdef ODYN_WITH_SUITESPARSE
-    return "klu";
-#else
-    return "eigen-sparse-lu";
-#endif
-  }
-
   /// Learns the pattern of an n x n matrix from its CSC arrays (which must outlive this
   /// object's use). Allocates.
   void analyze(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
@@ -47,19 +39,13 @@ class SparseLu {
 
   /// Factorizes the matrix with these values. False if it is singular to working precision or
   /// holds non-finite values.
-  bool factorize(const std::vector<double>& values) {
-    return impl_->factorize(values);
-  }
+  bool factorize(const std::vector<double>& values) { return impl_->factorize(values); }
 
   /// x <- A^-1 x.
-  void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) {
-    impl_->solve_in_place(x);
-  }
+  void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { impl_->solve_in_place(x); }
 
   /// Factorizations that chose their pivots afresh (the others reused them).
-  long pivoting_factorizations() const {
-    return impl_->pivoting;
-  }
+  long pivoting_factorizations() const { return impl_->pivoting; }
 
  private:
   /// Below this, min |U_ii| / max |U_ii| counts as singular.
