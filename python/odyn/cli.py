@@ -12,7 +12,7 @@ from typing import List, NoReturn, Optional, Tuple
 import numpy as np
 
 from . import _core
-from .results import ADAPTIVE_OPTIONAL, Interrupted, Result, integrators
+from .results import ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Interrupted, Result, integrators
 from .scene import Scene, load, write_table
 
 
@@ -41,7 +41,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--coordinates", choices=["absolute", "joint"],
                      help="dopri5 and dop853 on spatial models: step joint coordinates of a "
                      "spanning tree, loops closed by constraints (default: absolute)")
-    run.add_argument("--linear-solver", choices=["auto", "dense", "cholmod", "klu"],
+    run.add_argument("--linear-solver", choices=LINEAR_SOLVERS,
                      help="factorization of the linear systems: dense for small models, "
                      "sparse (cholmod, klu) for large ones (default: auto, by size)")
     run.add_argument("--out", help="write the output columns to a .csv or .npz file")
