@@ -17,6 +17,12 @@
 //   binary-tree              a ball-jointed binary tree of links, breadth first;
 //   four-bar-ladder          a column of four-bar loops (a bar hung on two ball-jointed
 //                            links per cell), N / 3 closed loops.
+// The same models in joint coordinates (analysis/joint_coordinates.hpp), named with "-joint":
+// spherical-chain-joint, revolute-chain-joint, binary-tree-joint and four-bar-ladder-joint (to
+// N = 256: its N / 3 loops make each evaluation O(N^2)). There step_s is one forward-dynamics
+// evaluation, what each stage of dopri5 or dop853 costs (the frames down the tree, the
+// closures, the articulated-body factorization and solve), and setup_s the assembly plus the
+// tree's construction.
 // setup_s: assembly (positions, the given velocities, accelerations) plus the integrator's
 // analysis, wall time. step_s: the median over 5 blocks of steps of the wall time per step.
 // peak_rss_mb: the process's peak resident memory once the case has run (sizes ascend, so it
@@ -167,6 +173,25 @@ void newton_per_step_of(Row& row, const odyn::IntegratorStatistics& statistics) 
   row.factorizations_per_step = static_cast<double>(statistics.factorizations) / steps;
 }
 
+/// Times `work` in blocks of at least 20 calls and 30 ms; the median of 5 blocks, per call.
+template <class Work>
+double median_time(Work&& work, long& calls) {
+  for (int k = 0; k < 3; ++k) work();
+  int block = 20;
+  std::vector<double> per_call;
+  for (int repeat = 0; repeat < 5; ++repeat) {
+    const auto t0 = Clock::now();
+    for (int k = 0; k < block; ++k) work();
+    const double elapsed = seconds_since(t0);
+    per_call.push_back(elapsed / block);
+    calls += block;
+    if (repeat == 0 && elapsed < 0.03)
+      block = std::min(2000, static_cast<int>(block * 0.03 / elapsed) + 1);
+  }
+  std::sort(per_call.begin(), per_call.end());
+  return per_call[per_call.size() / 2];
+}
+
 Row measure(const std::string& name, const Model& model) {
   Row row;
   row.name = name;
@@ -179,24 +204,42 @@ Row measure(const std::string& name, const Model& model) {
     row.assembly_s = seconds_since(start);
     odyn::GeneralizedAlpha<Model> integrator(model, ws);
     row.setup_s = seconds_since(start);
-    // Blocks of at least 20 steps and 30 ms; 5 blocks, the median per step.
-    for (int k = 0; k < 3; ++k) integrator.step(step);
-    int block = 20;
-    std::vector<double> per_step;
-    for (int repeat = 0; repeat < 5; ++repeat) {
-      const auto t0 = Clock::now();
-      for (int k = 0; k < block; ++k) integrator.step(step);
-      const double elapsed = seconds_since(t0);
-      per_step.push_back(elapsed / block);
-      row.steps += block;
-      if (repeat == 0 && elapsed < 0.03)
-        block = std::min(2000, static_cast<int>(block * 0.03 / elapsed) + 1);
-    }
-    const auto& statistics = integrator.statistics();
-    newton_per_step_of(row, statistics);
-    std::sort(per_step.begin(), per_step.end());
-    row.step_s = per_step[per_step.size() / 2];
+    row.step_s = median_time([&] { integrator.step(step); }, row.steps);
+    newton_per_step_of(row, integrator.statistics());
     if (!ws.q.allFinite()) row.status = "non-finite state";
+  } catch (const std::exception& e) {
+    row.status = std::string("failed: ") + e.what();
+    std::replace(row.status.begin(), row.status.end(), ',', ';');
+  }
+  row.peak_rss_mb = peak_rss_mb();
+  return row;
+}
+
+/// The model in joint coordinates: setup (assembly and the tree) and one forward-dynamics
+/// evaluation at the start, as each stage of an explicit integrator makes it.
+Row measure_joint(const std::string& name, const Model& model) {
+  Row row;
+  row.name = name;
+  row.bodies = model.num_bodies();
+  try {
+    odyn::Workspace<Model> ws(model);
+    const auto start = Clock::now();
+    odyn::assemble(model, ws);
+    row.assembly_s = seconds_since(start);
+    odyn::JointCoordinates<Model> coordinates(model, ws);
+    row.setup_s = seconds_since(start);
+    row.equations = static_cast<int>(coordinates.num_equations());
+    Eigen::VectorXd y(coordinates.num_positions() + coordinates.num_velocities());
+    coordinates.read_state(y);
+    bool ok = true;
+    row.step_s = median_time(
+        [&] {
+          coordinates.load(0.0, y);
+          coordinates.evaluate_constraints();
+          ok = coordinates.factorize() && coordinates.solve_accelerations() && ok;
+        },
+        row.steps);
+    if (!ok) row.status = "singular";
   } catch (const std::exception& e) {
     row.status = std::string("failed: ") + e.what();
     std::replace(row.status.begin(), row.status.end(), ',', ';');
@@ -237,6 +280,10 @@ int main(int argc, char** argv) {
       {"revolute-chain", [](int n) { return chain(n, Joint::hinge, false); }},
       {"binary-tree", [](int n) { return binary_tree(n); }},
       {"four-bar-ladder", [](int n) { return four_bar_ladder(n); }},
+      {"spherical-chain-joint", [](int n) { return chain(n, Joint::ball, false); }},
+      {"revolute-chain-joint", [](int n) { return chain(n, Joint::hinge, false); }},
+      {"binary-tree-joint", [](int n) { return binary_tree(n); }},
+      {"four-bar-ladder-joint", [](int n) { return four_bar_ladder(n); }},
   };
   std::ofstream csv(out);
   csv << "case,N,equations,setup_s,assembly_s,step_s,steps,newton_per_step,"
@@ -247,9 +294,11 @@ int main(int argc, char** argv) {
     if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
     for (int n = 1; n <= max_n; n *= 2) {
       if (n < min_n) continue;
-      if (name == "four-bar-ladder" && n < 3) continue;
-      const Model model = build(name == "four-bar-ladder" ? 3 * std::max(1, n / 3) : n);
-      const Row row = measure(name, model);
+      const bool ladder = name.starts_with("four-bar-ladder");
+      const bool joint = name.ends_with("-joint");
+      if (ladder && (n < 3 || (joint && n > 256))) continue;
+      const Model model = build(ladder ? 3 * std::max(1, n / 3) : n);
+      const Row row = joint ? measure_joint(name, model) : measure(name, model);
       csv << row.name << ',' << row.bodies << ',' << row.equations << ',' << row.setup_s << ','
           << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.newton_per_step
           << ',' << row.factorizations_per_step << ',' << row.peak_rss_mb << ',' << row.status

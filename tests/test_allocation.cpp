@@ -111,6 +111,40 @@ TEST_CASE("a dop853 step allocates nothing, in absolute and in joint coordinates
   check(std::type_identity<odyn::JointDormandPrince853<engine::Model>>{});
 }
 
+TEST_CASE("a dop853 step allocates nothing in joint coordinates' recursive passes",
+          "[workspace][dop853][joint]") {
+  // Ten ball-jointed links, the last tied back to the ground by a distance: 30 rates and one
+  // closure, above the size at which the whole saddle-point matrix is formed.
+  namespace sp = odyn::spatial;
+  using Model = sp::Model<sp::Spherical, sp::Distance, sp::Gravity>;
+  Model model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < 10; ++i) {
+    const odyn::BodyId body = model.add_body({.name = "link" + std::to_string(i),
+                                              .mass = 1.0,
+                                              .inertia = sp::Body::principal(0.01, 0.1, 0.1),
+                                              .position = {0.5 + i, 0.0, 0.0}});
+    model.add(sp::Spherical(
+        "joint" + std::to_string(i), previous,
+        previous.is_ground() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5, 0.0, 0.0), body,
+        {-0.5, 0.0, 0.0}));
+    previous = body;
+  }
+  model.add(sp::Distance("tie", previous, {0.5, 0.0, 0.0}, odyn::ground, {11.0, 0.0, -1.0}));
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  odyn::Workspace<Model> ws(model);
+  odyn::assemble(model, ws);
+  odyn::JointDormandPrince853<Model> integrator(model, ws, {}, {.rtol = 1e-8, .atol = 1e-8});
+  odyn::advance_to(model, ws, integrator, 0.01, 1e-3);  // warm up
+  allocations = 0;
+  counting = true;
+  odyn::advance_to(model, ws, integrator, 0.1, 1e-3);
+  integrator.refresh_blocks();
+  counting = false;
+  CHECK(integrator.statistics().steps > 5);
+  CHECK(allocations == 0);
+}
+
 TEST_CASE("a time step allocates nothing on the sparse paths (CHOLMOD's Schur complement, KLU)",
           "[workspace][sparse]") {
   // The engine's generalized-alpha run with each sparse factorization forced; under the

@@ -1,10 +1,14 @@
 // Joint coordinates (analysis/joint_coordinates.hpp) against independent references: the engine
 // against its minimal-coordinate solution, an open chain of every tree-joint kind against the
 // same chain in absolute coordinates (a different formulation, converged) and its energy, the
-// steady top (a free root closed by a spherical joint) against the gyroscope equation, a driven
-// slider-crank (a driver closing the loop) against the exact kinematics and absolute
-// coordinates; the tree the method picks; and the models it refuses, by name.
+// steady top (a ball joint in the tree) against the gyroscope equation, the conical pendulum
+// (a free root closed by a distance) against its closed-form motion, a double pendulum of ball
+// joints against its analytic small-oscillation modes, a 512-link ball chain and a ladder of
+// spatial four-bars against absolute coordinates, a driven slider-crank (a driver closing the loop)
+// against the exact kinematics and absolute coordinates; the tree the method picks; and the models
+// it refuses, by name.
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -195,10 +199,213 @@ TEST_CASE("Joint coordinates: an open chain of every tree-joint kind against abs
   CHECK(joint.phi < 1e-12);
 }
 
-TEST_CASE("Joint coordinates: a free root closed by a spherical joint (the steady top)",
+TEST_CASE("Joint coordinates: a ball joint carries the top (the steady top)",
           "[joint][pendulums]") {
   const auto top = steady_top::run<odyn::JointDormandPrince853>(joint_settings("dop853", 1e-11));
   steady_top::check_precession(top);
+}
+
+TEST_CASE("Joint coordinates: a free root closed by a distance (the conical pendulum)",
+          "[joint][pendulums]") {
+  // A body on a massless rod of length L from a fixed point, in steady conical motion: the rod
+  // at the angle theta from the vertical turns at Omega = sqrt(g / (L cos theta)). The rod acts
+  // through the centre, so the body does not turn. The body is a free root (6 rates) and the
+  // distance its only equation.
+  using Model = sp::Model<sp::Distance, sp::Gravity>;
+  const double g = 9.81, length = 1.0, theta = 0.5;
+  const double radius = length * std::sin(theta), height = -length * std::cos(theta);
+  const double rate = std::sqrt(g / (length * std::cos(theta)));
+  Model model;
+  sp::Body bob{.name = "bob",
+               .mass = 1.0,
+               .inertia = sp::Body::principal(0.01, 0.02, 0.03),
+               .position = {radius, 0.0, height}};
+  bob.linear_velocity = {0.0, radius * rate, 0.0};
+  const odyn::BodyId body = model.add_body(bob);
+  model.add(sp::Distance("rod", odyn::ground, Vector3d::Zero(), body, Vector3d::Zero()));
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -g}));
+  odyn::Workspace<Model> ws(model);
+  odyn::assemble(model, ws);
+  const odyn::JointCoordinates<Model> coordinates(model, ws);
+  CHECK(coordinates.num_velocities() == 6);
+  CHECK(coordinates.loop_closures() == std::vector<std::string>{"rod"});
+  odyn::DynamicsSettings settings = joint_settings("dop853", 1e-11);
+  settings.t_end = 2.0;
+  settings.output_interval = 0.05;
+  double position_error = 0.0, turn = 0.0;
+  odyn::simulate(model, ws, settings, [&](const auto& state) {
+    const Vector3d expected(radius * std::cos(rate * state.t), radius * std::sin(rate * state.t),
+                            height);
+    position_error = std::max(position_error, (state.frames[1].position - expected).norm());
+    turn = std::max(turn, state.frames[1].angular_velocity.norm());
+  });
+  INFO("position error " << position_error << " m, largest angular velocity " << turn);
+  CHECK(position_error < 1e-8);
+  CHECK(turn < 1e-10);
+}
+
+TEST_CASE("Joint coordinates: a double pendulum of ball joints against its analytic modes",
+          "[joint][pendulums]") {
+  // Two links of 1 m and 1 kg (inertia 1/12 across) hanging from ball joints, started at rest
+  // in one of the two small-oscillation modes of the compound double pendulum, within the
+  // x-z plane: M phi'' + K phi = 0 with M = [I + m a^2 + m l^2, m l a; m l a, I + m a^2],
+  // K = g diag(m a + m l, m a), a = l / 2. Each link's angle must follow eps v cos(omega t).
+  using Model = sp::Model<sp::Spherical, sp::Gravity>;
+  const double g = 9.81, l = 1.0, a = 0.5, m = 1.0, across = 1.0 / 12.0, eps = 1e-4;
+  Eigen::Matrix2d mass, stiffness;
+  mass << across + m * a * a + m * l * l, m * l * a, m * l * a, across + m * a * a;
+  stiffness << g * (m * a + m * l), 0.0, 0.0, g * m * a;
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> modes(stiffness, mass);
+  for (int mode = 0; mode < 2; ++mode) {
+    const double omega = std::sqrt(modes.eigenvalues()[mode]);
+    const Eigen::Vector2d shape = modes.eigenvectors().col(mode).normalized();
+    Model model;
+    const auto turned = [](double angle) {
+      return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Vector3d::UnitY()));
+    };
+    // Link k points down from its pivot along R_y(phi_k) (0, 0, -1).
+    const Vector3d down1 = turned(eps * shape[0]) * Vector3d(0, 0, -l);
+    const Vector3d down2 = turned(eps * shape[1]) * Vector3d(0, 0, -l);
+    const auto link = [&](const char* name, const Vector3d& centre, double angle) {
+      return sp::Body{.name = name,
+                      .mass = m,
+                      .inertia = sp::Body::principal(across, across, 5e-5),
+                      .position = centre,
+                      .orientation = turned(angle)};
+    };
+    const odyn::BodyId upper = model.add_body(link("upper", 0.5 * down1, eps * shape[0]));
+    const odyn::BodyId lower = model.add_body(link("lower", down1 + 0.5 * down2, eps * shape[1]));
+    model.add(sp::Spherical("shoulder", odyn::ground, Vector3d::Zero(), upper, {0, 0, a}));
+    model.add(sp::Spherical("elbow", upper, {0, 0, -a}, lower, {0, 0, a}));
+    model.add(sp::Gravity("gravity", {0.0, 0.0, -g}));
+    odyn::Workspace<Model> ws(model);
+    odyn::DynamicsSettings settings = joint_settings("dop853", 1e-12);
+    settings.t_end = 2.0 * (2.0 * std::numbers::pi / omega);  // two periods
+    settings.output_interval = settings.t_end / 40.0;
+    double error = 0.0;
+    odyn::simulate(model, ws, settings, [&](const auto& state) {
+      for (int k = 0; k < 2; ++k) {
+        const Eigen::Matrix3d& rotation = state.frames[k + 1].rotation;
+        const double angle = std::atan2(rotation(0, 2), rotation(2, 2));
+        error = std::max(error, std::abs(angle - eps * shape[k] * std::cos(omega * state.t)));
+      }
+    });
+    INFO("mode " << mode << ": omega " << omega << " rad/s, largest angle error " << error / eps
+                 << " of the amplitude");
+    CHECK(error < 1e-6 * eps);
+  }
+}
+
+TEST_CASE("Joint coordinates: a 512-link ball chain against absolute coordinates",
+          "[joint][large]") {
+  // The scaling report's rope: links of 1 m and 1 kg, horizontal and at rest, released under
+  // gravity. 1536 tree coordinates and no closure against 3584 absolute coordinates and 1536
+  // constraint equations (the sparse Schur complement), both with dop853 at 1e-10.
+  using Model = sp::Model<sp::Spherical, sp::Gravity>;
+  const int n = 512;
+  Model model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < n; ++i) {
+    const odyn::BodyId body =
+        model.add_body({.name = "link" + std::to_string(i),
+                        .mass = 1.0,
+                        .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
+                        .position = {0.5 + i, 0.0, 0.0}});
+    model.add(sp::Spherical("joint" + std::to_string(i), previous,
+                            previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0), body,
+                            {-0.5, 0.0, 0.0}));
+    previous = body;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  const auto run = [&](const char* coordinates) {
+    odyn::Workspace<Model> ws(model);
+    odyn::DynamicsSettings settings = joint_settings("dop853", 1e-10);
+    settings.coordinates = coordinates;
+    settings.t_end = 0.6;
+    settings.output_interval = 0.6;
+    Eigen::VectorXd centres(3 * n);
+    odyn::simulate(model, ws, settings, [&](const auto& state) {
+      for (int b = 1; b <= n; ++b) centres.segment<3>(3 * (b - 1)) = state.frames[b].position;
+    });
+    return centres;
+  };
+  const Eigen::VectorXd joint = run("joint"), absolute = run("absolute");
+  // The links near the pivot turn down; the far ones fall almost freely.
+  const double turn = std::atan2(-joint[2], joint[0]);  // the first link's angle below x
+  const double difference = (joint - absolute).cwiseAbs().maxCoeff();
+  INFO("first link turned " << turn << " rad; largest difference " << difference << " m");
+  CHECK(turn > 0.1);
+  CHECK(difference < 1e-8);
+}
+
+TEST_CASE("Joint coordinates: a ladder of spatial four-bars against absolute coordinates",
+          "[joint][large]") {
+  // Cells stacked along x, each a bar across y hung on two links from the previous bar (or the
+  // ground) by ball joints at all four corners: one closed loop a cell. Six cells: 18 bodies,
+  // 54 tree coordinates and 18 closure equations, so the closures go through their Schur
+  // complement and the recursive passes (not the small models' whole matrix). Against the same
+  // model in absolute coordinates (72 equations), both with dop853 at 1e-10.
+  using Model = sp::Model<sp::Spherical, sp::Gravity>;
+  Model model;
+  odyn::BodyId previous = odyn::ground;
+  const auto link = [](const std::string& name, const Vector3d& centre, bool across) {
+    return sp::Body{.name = name,
+                    .mass = 1.0,
+                    .inertia = across ? sp::Body::principal(1.0 / 12.0, 5e-3, 1.0 / 12.0)
+                                      : sp::Body::principal(5e-3, 1.0 / 12.0, 1.0 / 12.0),
+                    .position = centre};
+  };
+  for (int cell = 0; cell < 6; ++cell) {
+    const std::string c = std::to_string(cell);
+    const odyn::BodyId left = model.add_body(link("left" + c, {cell + 0.5, -0.5, 0.0}, false));
+    const odyn::BodyId right = model.add_body(link("right" + c, {cell + 0.5, 0.5, 0.0}, false));
+    const odyn::BodyId bar = model.add_body(link("bar" + c, {cell + 1.0, 0.0, 0.0}, true));
+    model.add(sp::Spherical("left-bottom" + c, previous, {0, -0.5, 0}, left, {-0.5, 0, 0}));
+    model.add(sp::Spherical("left-top" + c, left, {0.5, 0, 0}, bar, {0, -0.5, 0}));
+    model.add(sp::Spherical("right-bottom" + c, previous, {0, 0.5, 0}, right, {-0.5, 0, 0}));
+    model.add(sp::Spherical("right-top" + c, right, {0.5, 0, 0}, bar, {0, 0.5, 0}));
+    previous = bar;
+  }
+  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  {
+    odyn::Workspace<Model> ws(model);
+    odyn::assemble(model, ws);
+    const odyn::JointCoordinates<Model> coordinates(model, ws);
+    REQUIRE(coordinates.num_velocities() + coordinates.num_equations() >
+            odyn::JointCoordinates<Model>::dense_limit);
+    CHECK(coordinates.num_equations() == 18);
+  }
+  const auto run = [&](const char* coordinates) {
+    odyn::Workspace<Model> ws(model);
+    odyn::DynamicsSettings settings = joint_settings("dop853", 1e-10);
+    settings.coordinates = coordinates;
+    settings.t_end = 0.5;
+    settings.output_interval = 0.05;
+    std::vector<Eigen::VectorXd> poses;
+    double phi = 0.0;
+    odyn::simulate(model, ws, settings, [&](const auto& state) {
+      Eigen::VectorXd pose(12 * model.num_bodies());
+      for (int b = 1; b <= model.num_bodies(); ++b) {
+        pose.segment<3>(12 * (b - 1)) = state.frames[b].position;
+        pose.segment<9>(12 * (b - 1) + 3) = state.frames[b].rotation.reshaped();
+      }
+      poses.push_back(pose);
+      phi = std::max(phi, state.phi.cwiseAbs().maxCoeff());
+    });
+    return std::pair{poses, phi};
+  };
+  const auto [joint, joint_phi] = run("joint");
+  const auto [absolute, absolute_phi] = run("absolute");
+  REQUIRE(joint.size() == absolute.size());
+  double difference = 0.0;
+  for (std::size_t k = 0; k < joint.size(); ++k)
+    difference = std::max(difference, (joint[k] - absolute[k]).cwiseAbs().maxCoeff());
+  const double drop = -joint.back()[12 * 17 + 2];  // the last bar's centre
+  INFO("last bar fell " << drop << " m; largest difference " << difference << "; largest |Phi| "
+                        << joint_phi);
+  CHECK(drop > 0.5);
+  CHECK(difference < 1e-8);
+  CHECK(joint_phi < 1e-10);
 }
 
 TEST_CASE("Joint coordinates: a driver closes the loop like a joint (driven slider-crank)",

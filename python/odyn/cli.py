@@ -40,7 +40,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--max-step", type=float, help="largest step with error control, s")
     run.add_argument("--coordinates", choices=["absolute", "joint"],
                      help="dopri5 and dop853 on spatial models: step joint coordinates of a "
-                     "spanning tree, loops closed by constraints (default: absolute)")
+                     "spanning tree (recursive, linear in the number of bodies), loops closed "
+                     "by constraints (default: absolute)")
     run.add_argument("--linear-solver", choices=LINEAR_SOLVERS,
                      help="factorization of the linear systems: dense for small models, "
                      "sparse (cholmod, klu) for large ones (default: auto, by size)")

@@ -304,10 +304,11 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
 
     coordinates: "absolute" (every body's position and orientation, every joint a constraint)
     or, for spatial models with dopri5 or dop853, "joint": the bodies located through a
-    spanning tree of revolute, translational, cylindrical, universal and fixed joints, only the
-    joints that close loops (spherical joints, distances, drivers, the rest) as constraints.
-    Fewer unknowns, so each step costs less; reactions and outputs are the same as in absolute
-    coordinates. Redundant loop closures are refused (absolute coordinates handle them).
+    spanning tree of revolute, translational, cylindrical, universal, fixed and spherical
+    joints, only the joints that close loops (distances, drivers, the rest) as constraints.
+    Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
+    dynamics); reactions and outputs are the same as in absolute coordinates. Redundant loop
+    closures are refused (absolute coordinates handle them).
 
     linear_solver: the factorization of the linear systems of the assembly and the steps.
     "auto" (the default) picks by size and pattern: dense kernels for small models (tens of

@@ -2,37 +2,52 @@
 // Joint coordinates: the bodies located through a spanning tree of the model's joints, so that
 // only the joints that close loops stay constraint equations. The single-cylinder engine, for
 // instance, becomes crank angle, piston travel and the two angles of the piston pin, closed by
-// the crank pin's three equations: 4 coordinates and 3 equations instead of 18 and 17.
+// the crank pin's three equations: 4 coordinates and 3 equations instead of 18 and 17. A chain or
+// a tree of ball joints has no equation left at all.
 //
-// The tree. Joints that can carry a body (TreeJoint: revolute, translational, cylindrical,
-// universal, fixed) are taken greedily, most equations first (Kruskal), so that the joints left
-// to close loops have the fewest equations; spherical joints, distances and drivers always
-// close loops. A group of bodies that no tree joint ties to the ground gets a free root: one of
-// its bodies keeps its own position and quaternion.
+// The tree. Joints that can carry a body (spatial::CarriesBody: revolute, translational,
+// cylindrical, universal, fixed and spherical) are taken greedily, most equations first
+// (Kruskal), so that the joints left to close loops have the fewest equations; distances and
+// drivers always close loops. A group of bodies that no tree joint ties to the ground gets a
+// free root: one of its bodies keeps its own position and quaternion.
 //
-// The kinematics. Each tree joint moves its child by a product of exponentials (see
-// spatial/screw.hpp), measured from the assembled start (every joint coordinate 0 there). Going
-// down the tree gives every body's frame, the spatial Jacobian S_b (twists (omega, v_O) of the
-// body, global, per unit coordinate rate) and the bias acceleration c_b (the acceleration at
-// zero coordinate acceleration):
-//     V_child = V_parent + sum_i xi_i theta_i',
-//     A_child = A_parent + sum_i (xi_i theta_i'' + (V_i-1 x xi_i) theta_i').
-// In the bodies' own velocity coordinates v = J theta' and v' = J theta'' + c.
+// The kinematics. A tree joint moves its child by a product of exponentials (see
+// spatial/screw.hpp), measured from the assembled start (every joint coordinate 0 there), or,
+// for a ball joint, by a quaternion whose rates are the relative angular velocity in the
+// child's axes (a free root's quaternion and rates work the same way). Every spatial quantity
+// of a body (its twist (omega, v), its acceleration, its inertia, the wrenches on it) is given
+// in global axes at the body's own centre of mass, so a parent and its child differ by the
+// shift r = c_child - c_parent alone, and no lever arm grows with the distance from the global
+// origin (a long chain loses no digits at its far end). Going down the tree gives every body's
+// frame, its joint's motion columns S (twists per unit rate), its twist V and the acceleration
+// its joint adds at zero coordinate acceleration, c.
 //
-// The equations. With the bodies' block-diagonal mass M and their forces Q (gyroscopic terms
-// included), the closure equations' Jacobian C = Phi_q J and right-hand side gamma - Phi_q c:
-//     [J^T M J  C^T] [theta'']   [J^T (Q - M c)]
-//     [C        0  ] [lambda ] = [gamma - Phi_q c],
-// one small dense saddle-point matrix, factorized L D L^T (linalg/saddle_point_ldlt.hpp) at
-// every stage. The tree joints' equations hold exactly. At output points complete_workspace()
-// fills in what an absolute-coordinate run leaves in the workspace: q, v, v' = J theta'' + c,
-// every element's blocks and every lambda, the tree joints' from their bodies' own equations,
-// leaves first (B B^T lambda = B (Q - M v' - the constraint forces already known), B the
-// joint's block on its child; exact, since the equations are consistent).
+// The equations. With A = J^T M J the mass matrix in joint coordinates (J maps joint rates to
+// the bodies' twists) and C = Phi_q J the closures' Jacobian,
+//     [A  C^T] [theta'']   [J^T (Q - velocity terms)]
+//     [C  0  ] [lambda ] = [gamma - Phi_q c          ].
+// A is never formed: the articulated-body algorithm (Featherstone, Rigid Body Dynamics
+// Algorithms, 2008, ch. 7) factorizes it in one pass up the tree (factorize(): each body's
+// articulated inertia, its joint's pivot block D = S^T I^A S) and solves A x = J^T w for any
+// wrenches w in one pass up (the forces a subtree hands its parent) and one pass down (the
+// accelerations): O(N) for N bodies, whatever the shape of the tree. The closures go through
+// their Schur complement S = C A^-1 C^T (m x m, dense, from m tree solves at each
+// factorization), so that each saddle-point solve is two tree solves and one solve with S; the
+// cost is O(N (1 + m)): linear for trees and for models with few loops, while models with many
+// loops (a ladder of four-bars) are better run in absolute coordinates. Models of a few bodies
+// (up to dense_limit unknowns, the engine among them) form the saddle-point matrix instead (A
+// by the composite-rigid-body algorithm) and factorize it L D L^T
+// (linalg/saddle_point_ldlt.hpp): at that size, the passes cost more than the arithmetic.
+//
+// At output points complete_workspace() fills in what an absolute-coordinate run leaves in the
+// workspace: q, v, v', every element's blocks and every lambda, the tree joints' from their
+// bodies' own equations, leaves first (B B^T lambda = B (Q - M v' - the constraint forces
+// already known), B the joint's block on its child; exact, since the equations are consistent).
 //
 // Limits: spatial models; loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -46,6 +61,7 @@
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/core/rotation.hpp"
 #include "odyn/core/spatial.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
@@ -55,20 +71,57 @@
 
 namespace odyn {
 
+namespace detail {
+
+/// What the passes over the tree keep per body, in global axes at its centre.
+struct TreeNodeState {
+  Eigen::Matrix<double, 6, 6> motion =
+      Eigen::Matrix<double, 6, 6>::Zero();  // S: the joint's twists per unit rate (dof cols)
+  Eigen::Matrix<double, 6, 6> articulated =
+      Eigen::Matrix<double, 6, 6>::Zero();  // I^A during factorize(), then I^A - U D^-1 U^T
+  Eigen::Matrix<double, 6, 6> projected =
+      Eigen::Matrix<double, 6, 6>::Zero();  // U = I^A S (dof cols)
+  Eigen::Matrix<double, 6, 6> inverse_pivot =
+      Eigen::Matrix<double, 6, 6>::Zero();  // D^-1 = (S^T I^A S)^-1 (dof x dof)
+  Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();  // V = (omega, v_centre)
+  Eigen::Matrix<double, 6, 1> bias =
+      Eigen::Matrix<double, 6, 1>::Zero();  // c: the joint's acceleration at zero theta''
+  Eigen::Matrix<double, 6, 1> pivot_force =
+      Eigen::Matrix<double, 6, 1>::Zero();           // u = -S^T p in a solve (dof entries)
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // r = c_child - c_parent
+};
+
+/// One closure's Jacobian block on one body in spatial form, G = [Phi_angular R^T,
+/// Phi_linear], so that Phi_q v = G V with V the body's twist at its centre.
+struct ClosureBlock {
+  int node = 0;   // the body's place in tree_
+  int row = 0;    // first row in the closures' equations
+  int count = 0;  // rows
+  Eigen::Matrix<double, 6, 6> rows = Eigen::Matrix<double, 6, 6>::Zero();  // count rows used
+};
+
+}  // namespace detail
+
 template <class Model>
 class JointCoordinates {
   static_assert(std::is_same_v<typename Model::Space, Spatial>,
                 "joint coordinates are implemented for spatial models");
   using Vector6 = Eigen::Matrix<double, 6, 1>;
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Quaternion = Eigen::Matrix<double, 4, 1>;  // (w, x, y, z)
   using Frame = Spatial::Frame;
   using Screw = spatial::Screw;
 
  public:
   static constexpr const char* name = "joint";
+  /// Up to this many unknowns (joint rates plus closure equations), the saddle-point matrix is
+  /// formed and factorized whole (L D L^T, unrolled for small sizes), which costs less than the
+  /// recursive passes on models of a few bodies, such as the engine; above it, the passes.
+  static constexpr Eigen::Index dense_limit = 24;
 
   /// Builds the tree at the workspace's (assembled) state and takes that state as the start.
   /// Throws ModelError if the loop closures are redundant there.
-  /// (The closures' matrix is small and dense: `linear_solver` is not used.)
+  /// (The closures' Schur complement is small and dense: `linear_solver` is not used.)
   JointCoordinates(const Model& model, Workspace<Model>& ws,
                    LinearSolver /*linear_solver*/ = LinearSolver::automatic)
       : model_(model), ws_(ws) {
@@ -93,22 +146,23 @@ class JointCoordinates {
   void load(double t, const Eigen::VectorXd& y) {
     ws_.t = t;
     q_ = y.head(num_positions());
-    for (const TreeBody& node : tree_)
-      if (node.free) Spatial::normalize(q_.segment<Spatial::nq>(node.q_offset));
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free) Spatial::normalize(q_.segment<Spatial::nq>(node.q_offset));
+      if (node.kind == Kind::ball) q_.segment<4>(node.q_offset).normalize();
+    }
     v_ = y.tail(num_velocities());
     update_kinematics();
   }
 
   /// The coordinates' rate for the rates loaded last, at the positions held in y: a joint
-  /// coordinate moves with its rate, a free root's quaternion as in Spatial.
+  /// coordinate moves with its rate, a quaternion as in Spatial.
   void position_rate(const Eigen::VectorXd& y, Eigen::Ref<Eigen::VectorXd> rate) const {
     configuration_change(y, v_, rate);
   }
 
-  /// The closures' Phi and blocks, and C = Phi_q J (into the saddle-point matrix's rows n..).
+  /// The closures' Phi and blocks, and their rows of C in spatial form (see ClosureBlock).
   void evaluate_constraints() {
-    const Eigen::Index n = num_velocities();
-    kkt_.bottomLeftCorner(num_equations(), n).setZero();
+    std::size_t next = 0;
     for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int model_row) {
       constexpr int m = E::num_equations;
       element.evaluate(detail::input_of(element, ws_.frames, ws_.t), blocks);
@@ -119,63 +173,81 @@ class JointCoordinates {
       for (int k = 0; k < E::num_bodies; ++k) {
         const int b = element.bodies()[k].index;
         if (b == 0) continue;
-        for (int j = 0; j < num_columns(b); ++j)
-          kkt_.col(columns_[b][j]).template segment<m>(n + row).noalias() +=
-              blocks.jacobian[k] * body_column(b, j);
+        // Phi_q v = Phi_linear v_centre + Phi_angular R^T omega = G (omega, v_centre).
+        detail::ClosureBlock& block = closure_blocks_[next++];
+        block.rows.template topLeftCorner<m, 3>().noalias() =
+            blocks.jacobian[k].template rightCols<3>() * ws_.frames[b].rotation.transpose();
+        block.rows.template topRightCorner<m, 3>() = blocks.jacobian[k].template leftCols<3>();
       }
     });
   }
 
   void evaluate_forces() { odyn::evaluate_forces(model_, ws_); }
 
-  /// Factorizes [J^T M J  C^T; C  0] at the loaded positions (C from evaluate_constraints).
-  /// J^T M J: each body adds m J_v^T J_v + J_w^T I J_w over the coordinates that move it.
+  /// Factorizes at the loaded positions, with C from evaluate_constraints: small models the
+  /// whole saddle-point matrix (see dense_limit), others A by its articulated inertias (up the
+  /// tree) and the closures' Schur complement C A^-1 C^T. False if A or the Schur complement
+  /// is not positive definite (or the saddle-point matrix has a pivot of the wrong sign).
   bool factorize() {
-    kkt_.topLeftCorner(num_velocities(), num_velocities()).setZero();
-    for (int b = 1; b <= model_.num_bodies(); ++b) {
-      const auto& body = model_.body(BodyId{b});
-      for (int j = 0; j < num_columns(b); ++j) {
-        const Vector6& column_j = body_column(b, j);
-        const Eigen::Vector3d linear = body.mass * column_j.head<3>();
-        const Eigen::Vector3d angular = body.inertia * column_j.tail<3>();
-        for (int i = j; i < num_columns(b); ++i)
-          kkt_(columns_[b][i], columns_[b][j]) += body_column(b, i).template head<3>().dot(linear) +
-                                                  body_column(b, i).template tail<3>().dot(angular);
-      }
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const auto& body = model_.body(BodyId{tree_[i].body});
+      const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
+      Matrix6& inertia = nodes_[i].articulated;
+      inertia.setZero();
+      inertia.topLeftCorner<3, 3>().noalias() = rotation * body.inertia * rotation.transpose();
+      inertia.bottomRightCorner<3, 3>().diagonal().setConstant(body.mass);
     }
-    return kkt_ldlt_.compute(kkt_);
+    if (dense_) return factorize_dense();
+    for (std::size_t i = tree_.size(); i-- > 0;) {
+      const bool positive = with_dof(tree_[i].dof(), [&]<int K>() { return factor_node<K>(i); });
+      if (!positive) return false;
+    }
+    if (num_equations() == 0) return true;
+    // Column j of C A^-1 C^T: the closures' rates of the tree's motion under the unit
+    // multiplier e_j (the wrenches C^T e_j).
+    const Eigen::Index m = num_equations();
+    for (Eigen::Index j = 0; j < m; ++j) {
+      multiplier_.setZero();
+      multiplier_[j] = 1.0;
+      clear(force_);
+      add_closure_wrenches(multiplier_, -1.0, force_);  // p = -(C^T e_j)
+      tree_solve(false, increment_, motion_);
+      closure_rates(motion_, schur_.col(j));
+    }
+    schur_llt_.compute(schur_);
+    return schur_llt_.info() == Eigen::Success;
   }
 
-  /// theta'' and the closures' lambda at the loaded state, with the matrix factorized last:
-  /// the right-hand side J^T (Q - M c), gamma - Phi_q c.
+  /// theta'' and the closures' lambda at the loaded state, with the matrix factorized last.
   bool solve_accelerations() {
     odyn::evaluate_forces(model_, ws_);
-    const Eigen::Index n = num_velocities();
-    auto force = solution_.head(n);
-    force.setZero();
-    for (int b = 1; b <= model_.num_bodies(); ++b) {
-      const auto& body = model_.body(BodyId{b});
-      // Q - M c, by 3-vectors (see evaluate_forces).
-      const Eigen::Vector3d linear =
-          ws_.force.template segment<3>(6 * (b - 1)) - body.mass * bias_.segment<3>(6 * (b - 1));
-      const Eigen::Vector3d angular = ws_.force.template segment<3>(6 * (b - 1) + 3) -
-                                      body.inertia * bias_.segment<3>(6 * (b - 1) + 3);
-      for (int j = 0; j < num_columns(b); ++j)
-        force[columns_[b][j]] += body_column(b, j).template head<3>().dot(linear) +
-                                 body_column(b, j).template tail<3>().dot(angular);
+    // Each body's bias force: its velocity terms (m omega x v_centre in spatial form at the
+    // centre; Q already holds the gyroscopic torque) less its applied wrench (global axes).
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const int b = tree_[i].body;
+      const Frame& frame = ws_.frames[b];
+      const Vector6& twist = nodes_[i].twist;
+      const double mass = model_.body(BodyId{b}).mass;
+      force_[i].head<3>().noalias() =
+          -(frame.rotation * ws_.force.template segment<3>(6 * (b - 1) + 3));
+      force_[i].tail<3>() = mass * twist.head<3>().cross(twist.tail<3>()) -
+                            ws_.force.template segment<3>(6 * (b - 1));
     }
+    // The closures' right-hand side in spatial form: gamma less Phi_linear (omega x v_centre),
+    // the part of the centre's acceleration that the spatial acceleration leaves out.
     for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int) {
-      auto g = solution_.segment<E::num_equations>(n + row);
+      auto g = closure_rhs_.segment<E::num_equations>(row);
       g = element.gamma(detail::input_of(element, ws_.frames, ws_.t));
       for (int k = 0; k < E::num_bodies; ++k) {
         const int b = element.bodies()[k].index;
-        if (b != 0) g.noalias() -= blocks.jacobian[k] * bias_.segment<6>(6 * (b - 1));
+        if (b == 0) continue;
+        const Vector6& twist = nodes_[node_of_[b]].twist;
+        g.noalias() -=
+            blocks.jacobian[k].template leftCols<3>() * twist.head<3>().cross(twist.tail<3>());
       }
     });
-    kkt_ldlt_.solve_in_place(solution_);
-    qdd_ = solution_.head(n);
-    lambda_ = solution_.tail(num_equations());
-    return all_finite(solution_);
+    saddle_solve(true, true, closure_rhs_, qdd_, lambda_);
+    return all_finite(qdd_) && all_finite(lambda_);
   }
 
   const Eigen::VectorXd& accelerations() const { return qdd_; }
@@ -190,18 +262,20 @@ class JointCoordinates {
     return num_equations() > 0 ? phi_.cwiseAbs().maxCoeff() : 0.0;
   }
 
-  /// One (chord) correction towards the closures' Phi = 0, least distance in J^T M J.
+  /// One (chord) correction towards the closures' Phi = 0, least distance in A:
+  /// [A C^T; C 0] [dx; mu] = [0; -Phi].
   void correct_positions() {
-    solution_.head(num_velocities()).setZero();
-    solution_.tail(num_equations()) = -phi_;
-    kkt_ldlt_.solve_in_place(solution_);
+    closure_rhs_ = -phi_;
+    saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
     for (const TreeBody& node : tree_) {
-      if (node.free) {
+      if (node.kind == Kind::free) {
         const Eigen::Matrix<double, Spatial::nq, 1> from = q_.segment<Spatial::nq>(node.q_offset);
-        Spatial::integrate(from, solution_.segment<Spatial::nv>(node.v_offset),
+        Spatial::integrate(from, increment_.segment<Spatial::nv>(node.v_offset),
                            q_.segment<Spatial::nq>(node.q_offset));
+      } else if (node.kind == Kind::ball) {
+        turn(q_.segment<4>(node.q_offset), increment_.segment<3>(node.v_offset));
       } else {
-        q_.segment(node.q_offset, node.dof()) += solution_.segment(node.v_offset, node.dof());
+        q_.segment(node.q_offset, node.dof()) += increment_.segment(node.v_offset, node.dof());
       }
     }
     update_kinematics();
@@ -209,17 +283,19 @@ class JointCoordinates {
   }
 
   /// The part of a local error estimate e = (e_q, e_v) that outlives the projection ending the
-  /// step. correct_positions and correct_velocities move along A^-1 C^T (A = J^T M J) and remove
-  /// what C measures, so to first order only e - A^-1 C^T (C A^-1 C^T)^-1 C e is kept, for each
-  /// part; the matrix is the one factorized last (at a stage within the step, near its end). A
-  /// free root's quaternion error is taken as a turn, its change of length dropped (load()
-  /// normalizes).
+  /// step. correct_positions and correct_velocities move along A^-1 C^T and remove what C
+  /// measures, so to first order only e - A^-1 C^T (C A^-1 C^T)^-1 C e is kept, for each part;
+  /// the matrix is the one factorized last (at a stage within the step, near its end). A
+  /// quaternion's error is taken as a turn, its change of length dropped (load() normalizes).
   void keep_tangential(Eigen::Ref<Eigen::VectorXd> error) {
     if (num_equations() == 0) return;
     for (const TreeBody& node : tree_) {
-      if (node.free)
+      if (node.kind == Kind::free)
         increment_.segment<Spatial::nv>(node.v_offset) = Spatial::increment_of(
             q_.segment<Spatial::nq>(node.q_offset), error.segment<Spatial::nq>(node.q_offset));
+      else if (node.kind == Kind::ball)
+        increment_.segment<3>(node.v_offset) =
+            turn_of(q_.segment<4>(node.q_offset), error.segment<4>(node.q_offset));
       else
         increment_.segment(node.v_offset, node.dof()) = error.segment(node.q_offset, node.dof());
     }
@@ -228,37 +304,44 @@ class JointCoordinates {
     remove_normal_part(error.tail(num_velocities()));
   }
 
-  /// Removes C theta' + Phi_t, least change in J^T M J.
+  /// Removes C theta' + Phi_t, least change in A.
   void correct_velocities() {
-    const Eigen::Index n = num_velocities();
-    solution_.head(n).setZero();
-    auto residual = solution_.tail(num_equations());  // -(C theta' + Phi_t), in place
-    residual.noalias() = kkt_.bottomLeftCorner(num_equations(), n) * v_;
-    residual = -(residual + phi_t_);
-    kkt_ldlt_.solve_in_place(solution_);
-    v_ += solution_.head(n);
+    closure_rates(twist_view(), closure_rhs_);
+    closure_rhs_ = -(closure_rhs_ + phi_t_);
+    saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
+    v_ += increment_;
     update_velocities();
   }
 
   /// Brings the whole workspace to the loaded state as an absolute-coordinate run leaves it:
   /// q and v, every element's blocks, v' and lambda of every joint (tree joints included, for
-  /// their reactions). Reads the forces and theta'' of the last solve_accelerations, which
-  /// the integrator has made at this state.
+  /// their reactions). Reads the forces of the last solve_accelerations, which the integrator
+  /// has made at this state, and the theta'' held (solved or restored).
   void complete_workspace() {
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       const Frame& frame = ws_.frames[b];
-      const Eigen::Quaterniond turn(frame.rotation);
+      const Eigen::Quaterniond rotation(frame.rotation);
       ws_.q.template segment<3>(7 * (b - 1)) = frame.position;
-      ws_.q.template segment<4>(7 * (b - 1) + 3) << turn.w(), turn.x(), turn.y(), turn.z();
+      ws_.q.template segment<4>(7 * (b - 1) + 3) << rotation.w(), rotation.x(), rotation.y(),
+          rotation.z();
+      ws_.v.template segment<3>(6 * (b - 1)) = frame.linear_velocity;
+      ws_.v.template segment<3>(6 * (b - 1) + 3) = frame.angular_velocity;
     }
-    for (int b = 1; b <= model_.num_bodies(); ++b) {
-      ws_.v.template segment<3>(6 * (b - 1)) = ws_.frames[b].linear_velocity;
-      ws_.v.template segment<3>(6 * (b - 1) + 3) = ws_.frames[b].angular_velocity;
-    }
-    for (int b = 1; b <= model_.num_bodies(); ++b) {
-      auto vdot = ws_.vdot.template segment<6>(6 * (b - 1));
-      vdot = bias_.segment<6>(6 * (b - 1));
-      for (int j = 0; j < num_columns(b); ++j) vdot += body_column(b, j) * qdd_[columns_[b][j]];
+    // v' from theta'': the spatial accelerations down the tree, then the centres' accelerations
+    // (the spatial one plus omega x v_centre) and the body-frame angular accelerations.
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      Vector6 acceleration = nodes_[i].bias;
+      if (tree_[i].parent_node >= 0)
+        acceleration += shifted_motion(motion_[tree_[i].parent_node], nodes_[i].offset);
+      acceleration.noalias() += nodes_[i].motion.leftCols(tree_[i].dof()) *
+                                qdd_.segment(tree_[i].v_offset, tree_[i].dof());
+      motion_[i] = acceleration;
+      const int b = tree_[i].body;
+      const Vector6& twist = nodes_[i].twist;
+      ws_.vdot.template segment<3>(6 * (b - 1)) =
+          acceleration.tail<3>() + twist.head<3>().cross(twist.tail<3>());
+      ws_.vdot.template segment<3>(6 * (b - 1) + 3).noalias() =
+          ws_.frames[b].rotation.transpose() * acceleration.head<3>();
     }
     // Each body's constraint forces Phi_q^T lambda, from the closures first.
     constraint_force_.setZero();
@@ -278,7 +361,7 @@ class JointCoordinates {
     // The tree joints' blocks are evaluated here (the closures' are current from
     // evaluate_constraints(), which every state the integrator loads goes through).
     for (auto node = tree_.rbegin(); node != tree_.rend(); ++node) {
-      if (node->free) continue;
+      if (node->kind == Kind::free) continue;
       const int b = node->body;
       const auto& body = model_.body(BodyId{b});
       const Vector6 left =
@@ -286,7 +369,7 @@ class JointCoordinates {
           Spatial::mass_times(body.mass, body.inertia, ws_.vdot.template segment<6>(6 * (b - 1))) -
           constraint_force_.segment<6>(6 * (b - 1));
       model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-        if constexpr (spatial::TreeJoint<E>) {
+        if constexpr (spatial::CarriesBody<E>) {
           if (type != node->joint_type) return;
           constexpr int m = E::num_equations;
           const E& joint = pool[node->joint_index];
@@ -316,18 +399,290 @@ class JointCoordinates {
   }
 
  private:
+  enum class Kind { screws, ball, free };
+
   struct TreeBody {
-    int body = 0;       // the model's body index
-    int parent = 0;     // the parent's body index (0: the ground)
-    bool free = false;  // a root with its own position and quaternion
+    int body = 0;          // the model's body index
+    int parent = 0;        // the parent's body index (0: the ground)
+    int parent_node = -1;  // the parent's place in tree_ (-1: the ground)
+    Kind kind = Kind::screws;
     int q_offset = 0, v_offset = 0;
-    std::size_t joint_type = 0, joint_index = 0;  // the tree joint: type in the model, index
-    int child_side = 1;                           // which of its bodies this one is
-    std::vector<Screw> screws;                    // the tree joint's motions
+    std::size_t joint_type = 0, joint_index = 0;      // the tree joint: type in the model, index
+    int child_side = 1;                               // which of its bodies this one is
+    std::vector<Screw> screws;                        // a screw joint's motions
+    Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // a ball joint's point, parent's coords
     Eigen::Matrix3d rotation0 = Eigen::Matrix3d::Identity();  // in the parent's frame at start
     Eigen::Vector3d position0 = Eigen::Vector3d::Zero();
-    int dof() const { return free ? Spatial::nv : static_cast<int>(screws.size()); }
+    int dof() const {
+      return kind == Kind::free ? 6 : kind == Kind::ball ? 3 : static_cast<int>(screws.size());
+    }
+    int num_positions() const { return kind == Kind::free ? 7 : kind == Kind::ball ? 4 : dof(); }
   };
+
+  /// f.template operator()<K>() with the number of degrees of freedom K as a constant.
+  template <class F>
+  static bool with_dof(int dof, F&& f) {
+    switch (dof) {
+      case 0:
+        return f.template operator()<0>();
+      case 1:
+        return f.template operator()<1>();
+      case 2:
+        return f.template operator()<2>();
+      case 3:
+        return f.template operator()<3>();
+      case 4:
+        return f.template operator()<4>();
+      case 5:
+        return f.template operator()<5>();
+      default:
+        return f.template operator()<6>();
+    }
+  }
+
+  /// A motion vector (twist or acceleration) at the parent's centre, seen at the child's.
+  static Vector6 shifted_motion(const Vector6& motion, const Eigen::Vector3d& offset) {
+    Vector6 out;
+    out.head<3>() = motion.head<3>();
+    out.tail<3>() = motion.tail<3>() + motion.head<3>().cross(offset);
+    return out;
+  }
+
+  /// (omega, v) x (omega', v') = (omega x omega', omega x v' + v x omega').
+  static Vector6 motion_cross(const Vector6& a, const Vector6& b) {
+    Vector6 out;
+    out.head<3>() = a.head<3>().cross(b.head<3>());
+    out.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
+    return out;
+  }
+
+  /// ABA's inertia step for node i: U, D^-1, I^A - U D^-1 U^T, which the parent inherits
+  /// shifted to its centre: X^T I X, X = [1 0; -[r] 1], r = c_child - c_parent.
+  template <int K>
+  bool factor_node(std::size_t i) {
+    detail::TreeNodeState& node = nodes_[i];
+    if constexpr (K > 0) {
+      const auto motion = node.motion.template leftCols<K>();
+      auto projected = node.projected.template leftCols<K>();
+      projected.noalias() = node.articulated * motion;
+      const Eigen::Matrix<double, K, K> pivot = motion.transpose() * projected;
+      const Eigen::LLT<Eigen::Matrix<double, K, K>> llt(pivot);
+      if (llt.info() != Eigen::Success) return false;
+      auto inverse = node.inverse_pivot.template topLeftCorner<K, K>();
+      inverse = llt.solve(Eigen::Matrix<double, K, K>::Identity());
+      node.articulated.noalias() -= projected * (inverse * projected.transpose());
+    }
+    const int parent = tree_[i].parent_node;
+    if (parent >= 0) add_shifted_inertia(node.articulated, node.offset, nodes_[parent].articulated);
+    return true;
+  }
+
+  /// into += X^T inertia X, the inertia at a child's centre seen at its parent's:
+  /// X = [1 0; -[r] 1], r = c_child - c_parent.
+  static void add_shifted_inertia(const Matrix6& inertia, const Eigen::Vector3d& offset,
+                                  Matrix6& into) {
+    const Eigen::Matrix3d arm = skew(offset);
+    const Eigen::Matrix3d coupling =
+        inertia.topRightCorner<3, 3>() + arm * inertia.bottomRightCorner<3, 3>();
+    into.topLeftCorner<3, 3>() += inertia.topLeftCorner<3, 3>() +
+                                  arm * inertia.topRightCorner<3, 3>().transpose() - coupling * arm;
+    into.topRightCorner<3, 3>() += coupling;
+    into.bottomLeftCorner<3, 3>() += coupling.transpose();
+    into.bottomRightCorner<3, 3>() += inertia.bottomRightCorner<3, 3>();
+  }
+
+  /// The saddle-point matrix [A C^T; C 0] of a small model, lower triangle, factorized L D L^T.
+  /// A by the composite-rigid-body algorithm: each body's subtree inertia I^c, its joint's
+  /// block S^T I^c S, and the couplings S_j^T I^c S with every ancestor j (the subtree's
+  /// momentum per unit rate, moved up the tree). C: each closure block G times the motion
+  /// columns of the body's ancestors, moved to the body's centre.
+  bool factorize_dense() {
+    const Eigen::Index n = num_velocities();
+    for (std::size_t i = tree_.size(); i-- > 0;)
+      if (tree_[i].parent_node >= 0)
+        add_shifted_inertia(nodes_[i].articulated, nodes_[i].offset,
+                            nodes_[tree_[i].parent_node].articulated);
+    kkt_.setZero();
+    // Entries one 6-vector product at a time: at these sizes, Eigen's products of blocks of
+    // run-time size cost more in their set-up than in their arithmetic.
+    const auto fill = [&](const Vector6* left, int rows, int row0, const Matrix6& right,
+                          int columns, int column0) {
+      for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < columns; ++c) kkt_(row0 + r, column0 + c) += left[r].dot(right.col(c));
+    };
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const int dof = tree_[i].dof();
+      if (dof == 0) continue;
+      std::array<Vector6, 6> momentum;  // I^c S, carried up the tree
+      for (int k = 0; k < dof; ++k)
+        momentum[k].noalias() = nodes_[i].articulated * nodes_[i].motion.col(k);
+      fill(momentum.data(), dof, tree_[i].v_offset, nodes_[i].motion, dof, tree_[i].v_offset);
+      for (int j = static_cast<int>(i); tree_[j].parent_node >= 0;) {
+        for (int k = 0; k < dof; ++k)
+          momentum[k].head<3>() += nodes_[j].offset.cross(momentum[k].tail<3>());
+        j = tree_[j].parent_node;
+        fill(momentum.data(), dof, tree_[i].v_offset, nodes_[j].motion, tree_[j].dof(),
+             tree_[j].v_offset);
+      }
+    }
+    for (const detail::ClosureBlock& block : closure_blocks_) {
+      std::array<Vector6, 6> rows;
+      for (int r = 0; r < block.count; ++r) rows[r] = block.rows.row(r).transpose();
+      for (int j = block.node; j >= 0; j = tree_[j].parent_node) {
+        // G moved to node j's centre, so that it reads j's motion columns there: the rows act
+        // on twists as G X with X = [1 0; -[r] 1], r = c_body - c_j.
+        fill(rows.data(), block.count, static_cast<int>(n) + block.row, nodes_[j].motion,
+             tree_[j].dof(), tree_[j].v_offset);
+        for (int r = 0; r < block.count; ++r)
+          rows[r].head<3>() += nodes_[j].offset.cross(rows[r].tail<3>());
+      }
+    }
+    return kkt_ldlt_.compute(kkt_);
+  }
+
+  /// ABA's force step for node i: u = -S^T p, and the force the subtree hands its parent,
+  /// p + I^a c + U D^-1 u, moved to the parent's centre (torque plus r x force).
+  template <int K>
+  bool backward_node(std::size_t i, bool with_bias) {
+    detail::TreeNodeState& node = nodes_[i];
+    Vector6 handed = force_[i];
+    if (with_bias) handed.noalias() += node.articulated * node.bias;
+    if constexpr (K > 0) {
+      auto u = node.pivot_force.template head<K>();
+      u.noalias() = -(node.motion.template leftCols<K>().transpose() * force_[i]);
+      handed.noalias() += node.projected.template leftCols<K>() *
+                          (node.inverse_pivot.template topLeftCorner<K, K>() * u);
+    }
+    const int parent = tree_[i].parent_node;
+    if (parent >= 0) {
+      force_[parent].head<3>() += handed.head<3>() + node.offset.cross(handed.tail<3>());
+      force_[parent].tail<3>() += handed.tail<3>();
+    }
+    return true;
+  }
+
+  /// ABA's acceleration step for node i: theta''_i = D^-1 (u - U^T a'), a = a' + S theta''_i,
+  /// a' the parent's acceleration at this centre (plus c).
+  template <int K>
+  bool forward_node(std::size_t i, bool with_bias, Eigen::Ref<Eigen::VectorXd> x,
+                    std::vector<Vector6>& acceleration) {
+    const detail::TreeNodeState& node = nodes_[i];
+    const int parent = tree_[i].parent_node;
+    Vector6 a = parent >= 0 ? shifted_motion(acceleration[parent], node.offset) : Vector6::Zero();
+    if (with_bias) a += node.bias;
+    if constexpr (K > 0) {
+      auto theta = x.segment<K>(tree_[i].v_offset);
+      theta.noalias() = node.inverse_pivot.template topLeftCorner<K, K>() *
+                        (node.pivot_force.template head<K>() -
+                         node.projected.template leftCols<K>().transpose() * a);
+      a.noalias() += node.motion.template leftCols<K>() * theta;
+    }
+    acceleration[i] = a;
+    return true;
+  }
+
+  /// x = A^-1 (J^T w) with the factorization of the last factorize(), and every body's motion
+  /// J x (+ c with_bias) into `acceleration`. force_ holds p = -w per body (plus the velocity
+  /// terms with_bias) and is used up.
+  void tree_solve(bool with_bias, Eigen::Ref<Eigen::VectorXd> x,
+                  std::vector<Vector6>& acceleration) {
+    for (std::size_t i = tree_.size(); i-- > 0;)
+      with_dof(tree_[i].dof(), [&]<int K>() { return backward_node<K>(i, with_bias); });
+    for (std::size_t i = 0; i < tree_.size(); ++i)
+      with_dof(tree_[i].dof(),
+               [&]<int K>() { return forward_node<K>(i, with_bias, x, acceleration); });
+  }
+
+  /// [A C^T; C 0] [x; mu] = [J^T w; s], w from force_ (p = -w, with_force; else w = 0), by
+  /// x0 = A^-1 J^T w, mu = (C A^-1 C^T)^-1 (C x0 - s), x = x0 - A^-1 C^T mu. With bias, C x0
+  /// includes Phi_q c (s then stands for gamma in spatial form). motion_ ends with J x (+ c).
+  void saddle_solve(bool with_force, bool with_bias, const Eigen::VectorXd& s,
+                    Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu) {
+    if (dense_) return saddle_solve_dense(with_force, with_bias, s, x, mu);
+    if (with_force || with_bias) {
+      tree_solve(with_bias, x, motion_);
+    } else {
+      x.setZero();
+      clear(motion_);
+    }
+    if (num_equations() == 0) return;
+    closure_rates(motion_, mu);
+    mu -= s;
+    // By the triangular factors: LLT's own solveInPlace copies a Ref into a new vector.
+    schur_llt_.matrixL().solveInPlace(mu);
+    schur_llt_.matrixU().solveInPlace(mu);
+    clear(force_);
+    add_closure_wrenches(mu, 1.0, force_);  // p = -(-C^T mu)
+    tree_solve(false, closure_step_, closure_motion_);
+    x += closure_step_;
+    for (std::size_t i = 0; i < tree_.size(); ++i) motion_[i] += closure_motion_[i];
+  }
+
+  /// saddle_solve with the factorized saddle-point matrix: [A C^T; C 0] [x; mu] =
+  /// [-J^T (p + M c); s - Phi_q c], c the bodies' accelerations at zero theta'' (with_bias).
+  void saddle_solve_dense(bool with_force, bool with_bias, const Eigen::VectorXd& s,
+                          Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu) {
+    const Eigen::Index n = num_velocities();
+    solution_.tail(num_equations()) = s;
+    if (with_bias) {
+      for (std::size_t i = 0; i < tree_.size(); ++i) {
+        const int parent = tree_[i].parent_node;
+        motion_[i] = nodes_[i].bias;
+        if (parent >= 0) motion_[i] += shifted_motion(motion_[parent], nodes_[i].offset);
+        // p + M c, M the body's own inertia at its centre (global axes).
+        const auto& body = model_.body(BodyId{tree_[i].body});
+        const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
+        force_[i].head<3>().noalias() +=
+            rotation * (body.inertia * (rotation.transpose() * motion_[i].head<3>()));
+        force_[i].tail<3>() += body.mass * motion_[i].tail<3>();
+      }
+      closure_rates(motion_, mu);
+      solution_.tail(num_equations()) -= mu;
+    }
+    if (with_force || with_bias) {
+      for (std::size_t i = tree_.size(); i-- > 0;) {
+        const TreeBody& node = tree_[i];
+        for (int k = 0; k < node.dof(); ++k)
+          solution_[node.v_offset + k] = -nodes_[i].motion.col(k).dot(force_[i]);
+        if (node.parent_node >= 0) {
+          Vector6& into = force_[node.parent_node];
+          into.head<3>() += force_[i].head<3>() + nodes_[i].offset.cross(force_[i].tail<3>());
+          into.tail<3>() += force_[i].tail<3>();
+        }
+      }
+    } else {
+      solution_.head(n).setZero();
+    }
+    kkt_ldlt_.solve_in_place(solution_);
+    x = solution_.head(n);
+    mu = solution_.tail(num_equations());
+  }
+
+  /// The closures' rates G V for the bodies' motions V (twists or accelerations).
+  void closure_rates(const std::vector<Vector6>& motion, Eigen::Ref<Eigen::VectorXd> out) const {
+    out.setZero();
+    for (const detail::ClosureBlock& block : closure_blocks_)
+      for (int r = 0; r < block.count; ++r)
+        out[block.row + r] += block.rows.row(r).dot(motion[block.node]);
+  }
+
+  /// force += sign C^T lambda, as wrenches (global axes, at the centres).
+  void add_closure_wrenches(const Eigen::Ref<const Eigen::VectorXd>& lambda, double sign,
+                            std::vector<Vector6>& force) const {
+    for (const detail::ClosureBlock& block : closure_blocks_)
+      force[block.node].noalias() += sign * (block.rows.topRows(block.count).transpose() *
+                                             lambda.segment(block.row, block.count));
+  }
+
+  static void clear(std::vector<Vector6>& vectors) {
+    for (Vector6& v : vectors) v.setZero();
+  }
+
+  /// The bodies' twists, as the closures read them.
+  std::vector<Vector6>& twist_view() {
+    for (std::size_t i = 0; i < tree_.size(); ++i) motion2_[i] = nodes_[i].twist;
+    return motion2_;
+  }
 
   /// f(element, blocks, closure_row, model_row) for every loop-closing constraint element.
   template <class F>
@@ -358,7 +713,7 @@ class JointCoordinates {
     const int nb = model_.num_bodies();
     std::vector<Edge> edges;
     model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-      if constexpr (spatial::TreeJoint<E>)
+      if constexpr (spatial::CarriesBody<E>)
         for (std::size_t i = 0; i < pool.size(); ++i)
           edges.push_back(
               {type, i, pool[i].bodies()[0].index, pool[i].bodies()[1].index, E::num_equations});
@@ -393,7 +748,7 @@ class JointCoordinates {
       if (start != 0) {
         TreeBody node;
         node.body = start;
-        node.free = true;
+        node.kind = Kind::free;
         tree_.push_back(node);
       }
       std::vector<int> queue{start};
@@ -412,18 +767,26 @@ class JointCoordinates {
     grow(0);
     for (int b = 1; b <= nb; ++b)
       if (!reached[b]) grow(b);
+    node_of_.assign(static_cast<std::size_t>(nb + 1), -1);
+    for (std::size_t i = 0; i < tree_.size(); ++i) node_of_[tree_[i].body] = static_cast<int>(i);
     // Each tree joint's motions, seen from its parent, and the child's pose at the start.
     for (TreeBody& node : tree_) {
-      if (node.free) continue;
+      if (node.kind == Kind::free) continue;
+      node.parent_node = node.parent == 0 ? -1 : node_of_[node.parent];
       const Edge& edge = edges[parent_edge[node.body]];
       model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-        if constexpr (spatial::TreeJoint<E>) {
+        if constexpr (spatial::CarriesBody<E>) {
           if (type != edge.type) return;
           const E& joint = pool[edge.index];
           const int parent_side = joint.bodies()[0].index == node.parent ? 0 : 1;
-          const auto screws =
-              joint.tree_screws(detail::input_of(joint, ws_.frames, ws_.t), parent_side);
-          node.screws.assign(screws.begin(), screws.end());
+          const auto in = detail::input_of(joint, ws_.frames, ws_.t);
+          if constexpr (spatial::TreeJoint<E>) {
+            const auto screws = joint.tree_screws(in, parent_side);
+            node.screws.assign(screws.begin(), screws.end());
+          } else {
+            node.kind = Kind::ball;
+            node.pivot = joint.tree_pivot(in, parent_side);
+          }
           node.joint_type = type;
           node.joint_index = edge.index;
           node.child_side = 1 - parent_side;
@@ -438,7 +801,7 @@ class JointCoordinates {
     for (TreeBody& node : tree_) {
       node.q_offset = q_offset;
       node.v_offset = v_offset;
-      q_offset += node.free ? Spatial::nq : node.dof();
+      q_offset += node.num_positions();
       v_offset += node.dof();
     }
     q_.setZero(q_offset);
@@ -451,6 +814,10 @@ class JointCoordinates {
           if (!in_tree[type][i]) {
             closures_[type].push_back({i, row});
             closure_names_.push_back(pool[i].name());
+            for (int k = 0; k < E::num_bodies; ++k) {
+              const int b = pool[i].bodies()[k].index;
+              if (b != 0) closure_blocks_.push_back({node_of_[b], row, E::num_equations});
+            }
             row += E::num_equations;
           }
     });
@@ -458,42 +825,42 @@ class JointCoordinates {
   }
 
   void size_buffers() {
-    const int nb = model_.num_bodies();
     const Eigen::Index n = num_velocities(), m = num_equations();
-    // The coordinates that move each body: its ancestors' and its own, in increasing order
-    // (offsets follow the breadth-first order, so a parent's come first).
-    columns_.assign(static_cast<std::size_t>(nb + 1), {});
-    first_column_.assign(static_cast<std::size_t>(nb + 2), 0);
-    for (const TreeBody& node : tree_) {
-      auto& columns = columns_[node.body];
-      if (!node.free) columns = columns_[node.parent];
-      for (int i = 0; i < node.dof(); ++i) columns.push_back(node.v_offset + i);
-    }
-    for (int b = 0; b <= nb; ++b)
-      first_column_[b + 1] = first_column_[b] + static_cast<int>(columns_[b].size());
-    spatial_columns_.assign(static_cast<std::size_t>(first_column_[nb + 1]), Vector6::Zero());
-    body_columns_ = spatial_columns_;
-    twist_.assign(static_cast<std::size_t>(nb + 1), Vector6::Zero());
-    spatial_bias_.assign(static_cast<std::size_t>(nb + 1), Vector6::Zero());
-    bias_.setZero(6 * nb);
-    constraint_force_.setZero(6 * nb);
+    nodes_.assign(tree_.size(), detail::TreeNodeState{});
+    force_.assign(tree_.size(), Vector6::Zero());
+    motion_ = force_;
+    motion2_ = force_;
+    closure_motion_ = force_;
+    constraint_force_.setZero(6 * model_.num_bodies());
     phi_t_.setZero(m);
     lambda_.setZero(m);
+    multiplier_.setZero(m);
+    closure_rhs_.setZero(m);
+    dense_ = n + m <= dense_limit;
+    if (dense_) {
+      kkt_.setZero(n + m, n + m);
+      kkt_ldlt_.resize(n, m);
+      solution_.setZero(n + m);
+    } else {
+      schur_.setZero(m, m);
+      schur_llt_.compute(Eigen::MatrixXd::Identity(m, m));  // sizes its storage once
+    }
     qdd_.setZero(n);
-    kkt_.setZero(n + m, n + m);
-    solution_.setZero(n + m);
     increment_.setZero(n);
-    kkt_ldlt_.resize(n, m);
+    increment2_.setZero(n);
+    closure_step_.setZero(n);
   }
 
-  /// Joint coordinates 0 at the start, free roots where they are; the rates nearest the
-  /// bodies' velocities in the mass metric that satisfy the closures (the same rates, for a
-  /// consistent state): [J^T M J  C^T; C  0] [theta'; mu] = [J^T M v; -Phi_t].
+  /// Joint coordinates 0 at the start (quaternions 1), free roots where they are; the rates
+  /// nearest the bodies' velocities in the mass metric that satisfy the closures (the same
+  /// rates, for a consistent state): [A C^T; C 0] [theta'; mu] = [J^T M v; -Phi_t].
   void initial_state() {
-    for (const TreeBody& node : tree_)
-      if (node.free)
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free)
         q_.segment<Spatial::nq>(node.q_offset) =
             ws_.q.template segment<Spatial::nq>(7 * (node.body - 1));
+      if (node.kind == Kind::ball) q_.segment<4>(node.q_offset) << 1.0, 0.0, 0.0, 0.0;
+    }
     const Eigen::VectorXd velocities = ws_.v;
     update_kinematics();
     evaluate_constraints();
@@ -503,214 +870,237 @@ class JointCoordinates {
       throw ModelError("joint coordinates",
                        "the mass matrix in joint coordinates is singular; every body of the tree "
                        "needs a positive mass and inertia");
-    solution_.setZero();
-    for (int b = 1; b <= model_.num_bodies(); ++b) {
+    // The momenta M v as wrenches at the centres (global axes): p = -M v.
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const int b = tree_[i].body;
       const auto& body = model_.body(BodyId{b});
-      const Vector6 momentum =
-          Spatial::mass_times(body.mass, body.inertia, velocities.segment<6>(6 * (b - 1)));
-      for (int j = 0; j < num_columns(b); ++j)
-        solution_[columns_[b][j]] += body_column(b, j).dot(momentum);
+      force_[i].head<3>().noalias() =
+          -(ws_.frames[b].rotation * (body.inertia * velocities.segment<3>(6 * (b - 1) + 3)));
+      force_[i].tail<3>() = -body.mass * velocities.segment<3>(6 * (b - 1));
     }
-    solution_.tail(num_equations()) = -phi_t_;
-    kkt_ldlt_.solve_in_place(solution_);
-    v_ = solution_.head(num_velocities());
-    update_kinematics();
+    closure_rhs_ = -phi_t_;
+    saddle_solve(true, false, closure_rhs_, v_, multiplier_);
+    update_velocities();
   }
 
-  /// Refuses closures whose equations repeat each other at the start.
+  /// Refuses closures whose equations repeat each other at the start: the rank of C, whose
+  /// rows C^T e_j = J^T (G^T e_j) are the closures' unit wrenches summed up the tree.
   void check_closures() {
-    if (num_equations() == 0) return;
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(kkt_.bottomLeftCorner(num_equations(), num_velocities()));
+    const Eigen::Index m = num_equations();
+    if (m == 0) return;
+    Eigen::MatrixXd jacobian(m, num_velocities());
+    for (Eigen::Index j = 0; j < m; ++j) {
+      multiplier_.setZero();
+      multiplier_[j] = 1.0;
+      clear(force_);
+      add_closure_wrenches(multiplier_, 1.0, force_);
+      for (std::size_t i = tree_.size(); i-- > 0;) {
+        const TreeBody& node = tree_[i];
+        jacobian.row(j).segment(node.v_offset, node.dof()) =
+            (nodes_[i].motion.leftCols(node.dof()).transpose() * force_[i]).transpose();
+        if (node.parent_node >= 0) {
+          Vector6& into = force_[node.parent_node];
+          into.head<3>() += force_[i].head<3>() + nodes_[i].offset.cross(force_[i].tail<3>());
+          into.tail<3>() += force_[i].tail<3>();
+        }
+      }
+    }
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(jacobian);
     lu.setThreshold(1e-10);
-    if (lu.rank() < num_equations()) {
+    if (lu.rank() < m) {
       std::string names;
       for (const auto& name : closure_names_) names += (names.empty() ? "'" : ", '") + name + "'";
       throw ModelError("joint coordinates",
                        "the loop-closure equations of " + names + " are redundant (rank " +
-                           std::to_string(lu.rank()) + " of " + std::to_string(num_equations()) +
+                           std::to_string(lu.rank()) + " of " + std::to_string(m) +
                            "); use absolute coordinates, which run with redundant constraints");
     }
   }
 
+  /// A unit quaternion turned by exp(increment) on the right (in its own axes).
+  static void turn(Eigen::Ref<Quaternion> q, const Eigen::Ref<const Eigen::Vector3d>& increment) {
+    Eigen::Quaterniond turned =
+        Eigen::Quaterniond(q[0], q[1], q[2], q[3]) * quaternion_exp(increment);
+    turned.normalize();
+    q << turned.w(), turned.x(), turned.y(), turned.z();
+  }
+
+  /// The turn (in the quaternion's own axes) whose rate at q is dq: 2 vec(q* dq).
+  static Eigen::Vector3d turn_of(const Eigen::Ref<const Quaternion>& q,
+                                 const Eigen::Ref<const Quaternion>& dq) {
+    const Eigen::Quaterniond product = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).conjugate() *
+                                       Eigen::Quaterniond(dq[0], dq[1], dq[2], dq[3]);
+    return 2.0 * product.vec();
+  }
+
   /// The change of the coordinates (the first entries of `change`) for rates w at positions q:
-  /// a joint coordinate moves with its rate, a free root's quaternion as in Spatial.
+  /// a joint coordinate moves with its rate, a quaternion as q' = q (0, w) / 2.
   void configuration_change(const Eigen::Ref<const Eigen::VectorXd>& q,
                             const Eigen::Ref<const Eigen::VectorXd>& w,
                             Eigen::Ref<Eigen::VectorXd> change) const {
     for (const TreeBody& node : tree_) {
-      if (node.free)
+      if (node.kind == Kind::free) {
         change.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
             q.segment<Spatial::nq>(node.q_offset), w.segment<Spatial::nv>(node.v_offset));
-      else
+      } else if (node.kind == Kind::ball) {
+        const auto at = q.segment<4>(node.q_offset);
+        const auto rate = w.segment<3>(node.v_offset);
+        const Eigen::Quaterniond turned = Eigen::Quaterniond(at[0], at[1], at[2], at[3]) *
+                                          Eigen::Quaterniond(0.0, rate[0], rate[1], rate[2]);
+        change.segment<4>(node.q_offset) << 0.5 * turned.w(), 0.5 * turned.x(), 0.5 * turned.y(),
+            0.5 * turned.z();
+      } else {
         change.segment(node.q_offset, node.dof()) = w.segment(node.v_offset, node.dof());
+      }
     }
   }
 
   /// x - A^-1 C^T (C A^-1 C^T)^-1 C x, a rate-space vector with no component that C measures.
   void remove_normal_part(Eigen::Ref<Eigen::VectorXd> x) {
-    const Eigen::Index n = num_velocities();
-    solution_.head(n).setZero();
-    auto measured = solution_.tail(num_equations());  // -C x, in place (no temporary)
-    measured.noalias() = kkt_.bottomLeftCorner(num_equations(), n) * x;
-    measured = -measured;
-    kkt_ldlt_.solve_in_place(solution_);
-    x += solution_.head(n);
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const TreeBody& node = tree_[i];
+      motion2_[i] = node.parent_node >= 0
+                        ? shifted_motion(motion2_[node.parent_node], nodes_[i].offset)
+                        : Vector6::Zero();
+      motion2_[i].noalias() +=
+          nodes_[i].motion.leftCols(node.dof()) * x.segment(node.v_offset, node.dof());
+    }
+    closure_rates(motion2_, closure_rhs_);
+    closure_rhs_ = -closure_rhs_;
+    saddle_solve(false, false, closure_rhs_, increment2_, multiplier_);
+    x += increment2_;
   }
 
-  int num_columns(int body) const { return first_column_[body + 1] - first_column_[body]; }
-  /// Column j of body b's spatial Jacobian S_b and of its Jacobian J_b.
-  Vector6& spatial_column(int b, int j) { return spatial_columns_[first_column_[b] + j]; }
-  const Vector6& body_column(int b, int j) const { return body_columns_[first_column_[b] + j]; }
-
-  /// to = from, by 3-vectors: from's halves were just stored a number at a time, and a copy
-  /// in pairs would wait on them (see evaluate_forces).
-  static void copy_halves(const Vector6& from, Vector6& to) {
-    to.head<3>() = from.head<3>();
-    to.tail<3>() = from.tail<3>();
-  }
-
-  /// A joint's motion xi at its rate, added to the twist carried so far, and the bias that the
-  /// carrying adds: (twist x xi) rate, with (omega, v) x (omega', v') = (omega x omega',
-  /// omega x v' + v x omega'). By 3-vectors: the cross products are stored a number at a time,
-  /// and 6-vector arithmetic on them would read pairs (see evaluate_forces).
-  static void add_motion(const Vector6& xi, double rate, Vector6& twist, Vector6& bias) {
-    const Eigen::Vector3d omega = twist.head<3>(), velocity = twist.tail<3>();
-    bias.head<3>() += omega.cross(xi.head<3>()) * rate;
-    bias.tail<3>() += (omega.cross(xi.tail<3>()) + velocity.cross(xi.head<3>())) * rate;
-    twist.head<3>() += xi.head<3>() * rate;
-    twist.tail<3>() += xi.tail<3>() * rate;
-  }
-
-  /// Down the tree: frames, spatial Jacobians, twists and bias accelerations; then J and c in
-  /// the bodies' velocity coordinates (linear velocity of the centre, body-frame omega).
+  /// Down the tree: every body's frame, its joint's motion columns S at its centre and its
+  /// offset from its parent; then the velocities (update_velocities).
   void update_kinematics() {
-    for (const TreeBody& node : tree_) {
-      const int b = node.body;
-      Frame& frame = ws_.frames[b];
-      Vector6 twist, bias;  // (omega, velocity of the point at the origin), global
-      if (node.free) {
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const TreeBody& node = tree_[i];
+      detail::TreeNodeState& state = nodes_[i];
+      Frame& frame = ws_.frames[node.body];
+      const Frame& parent = ws_.frames[node.parent];
+      if (node.kind == Kind::free) {
         Spatial::make_frame(q_.segment<Spatial::nq>(node.q_offset),
                             v_.segment<Spatial::nv>(node.v_offset), frame);
-        const Eigen::Vector3d omega = frame.rotation * frame.angular_velocity;
+        // Rates (v_centre, omega in body axes): translations, then turns about the centre.
+        state.motion.setZero();
+        state.motion.bottomLeftCorner<3, 3>().setIdentity();
+        state.motion.topRightCorner<3, 3>() = frame.rotation;
+      } else if (node.kind == Kind::ball) {
+        const auto quaternion = q_.segment<4>(node.q_offset);
+        const Eigen::Matrix3d axes =
+            parent.rotation *
+            Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2], quaternion[3])
+                .toRotationMatrix();
+        const Eigen::Vector3d pivot = parent.position + parent.rotation * node.pivot;
+        frame.rotation = axes * node.rotation0;
+        frame.position = pivot + axes * (node.position0 - node.pivot);
+        // Turns about the pivot, about the axes the quaternion's rates are given in.
+        const Eigen::Vector3d arm = frame.position - pivot;
         for (int k = 0; k < 3; ++k) {
-          spatial_column(b, k) << Eigen::Vector3d::Zero(), Eigen::Vector3d::Unit(k);
-          spatial_column(b, 3 + k) << frame.rotation.col(k),
-              frame.position.cross(frame.rotation.col(k));
+          state.motion.col(k).head<3>() = axes.col(k);
+          state.motion.col(k).tail<3>() = axes.col(k).cross(arm);
         }
-        twist << omega, frame.linear_velocity + frame.position.cross(omega);
-        bias << Eigen::Vector3d::Zero(), frame.linear_velocity.cross(omega);
       } else {
-        const Frame& parent = ws_.frames[node.parent];
-        const int inherited = num_columns(node.parent);
-        for (int j = 0; j < inherited; ++j) spatial_column(b, j) = spatial_column(node.parent, j);
-        copy_halves(twist_[node.parent], twist);
-        copy_halves(spatial_bias_[node.parent], bias);
         // The frame the motions so far carry: its rotation and where the parent's origin went.
         Eigen::Matrix3d rotation = parent.rotation;
         Eigen::Vector3d origin = parent.position;
-        for (int i = 0; i < static_cast<int>(node.screws.size()); ++i) {
-          const Screw& screw = node.screws[i];
-          const double angle = q_[node.q_offset + i];
-          const double rate = v_[node.v_offset + i];
-          const Eigen::Vector3d axis = rotation * screw.axis;
-          Vector6 xi;
+        std::array<Eigen::Vector3d, 6> axis, point;
+        const int count = node.dof();
+        for (int k = 0; k < count; ++k) {
+          const Screw& screw = node.screws[k];
+          const double angle = q_[node.q_offset + k];
+          axis[k] = rotation * screw.axis;
           if (screw.kind == Screw::Kind::rotation) {
-            const Eigen::Vector3d point = origin + rotation * screw.point;
-            xi << axis, point.cross(axis);
+            point[k] = origin + rotation * screw.point;
             // Rodrigues on the right: R exp(angle [a]) = c R + s [R a] R + (1 - c) (R a) a^T.
             const double sine = std::sin(angle), cosine = std::cos(angle);
-            for (int k = 0; k < 3; ++k) {
-              const Eigen::Vector3d column = rotation.col(k);
-              rotation.col(k) = cosine * column + sine * axis.cross(column) +
-                                ((1.0 - cosine) * screw.axis[k]) * axis;
+            for (int j = 0; j < 3; ++j) {
+              const Eigen::Vector3d column = rotation.col(j);
+              rotation.col(j) = cosine * column + sine * axis[k].cross(column) +
+                                ((1.0 - cosine) * screw.axis[j]) * axis[k];
             }
-            origin = point - rotation * screw.point;
+            origin = point[k] - rotation * screw.point;
           } else {
-            xi << Eigen::Vector3d::Zero(), axis;
-            origin += angle * axis;
+            origin += angle * axis[k];
           }
-          add_motion(xi, rate, twist, bias);
-          copy_halves(xi, spatial_column(b, inherited + i));
         }
         frame.rotation = rotation * node.rotation0;
         frame.position = origin + rotation * node.position0;
-        frame.angular_velocity = frame.rotation.transpose() * twist.head<3>();
-        frame.linear_velocity = twist.tail<3>() + twist.head<3>().cross(frame.position);
-      }
-      // v_centre = v_O + omega x x and omega_body = R^T omega, column by column.
-      for (int j = 0; j < num_columns(b); ++j) {
-        const Vector6& xi = spatial_column(b, j);
-        Vector6& column = body_columns_[first_column_[b] + j];
-        column.head<3>() = xi.tail<3>() + xi.head<3>().cross(frame.position);
-        column.tail<3>().noalias() = frame.rotation.transpose() * xi.head<3>();
-      }
-      store_motion(b, frame, twist, bias);
-    }
-  }
-
-  /// After a change of the rates alone (correct_velocities): twists, bias accelerations and
-  /// the frames' velocities again, with the frames and screws of the last update_kinematics.
-  /// The same operations in the same order as there, so the same numbers.
-  void update_velocities() {
-    for (const TreeBody& node : tree_) {
-      const int b = node.body;
-      Frame& frame = ws_.frames[b];
-      Vector6 twist, bias;
-      if (node.free) {
-        frame.linear_velocity = v_.segment<3>(node.v_offset);
-        frame.angular_velocity = v_.segment<3>(node.v_offset + 3);
-        const Eigen::Vector3d omega = frame.rotation * frame.angular_velocity;
-        twist << omega, frame.linear_velocity + frame.position.cross(omega);
-        bias << Eigen::Vector3d::Zero(), frame.linear_velocity.cross(omega);
-      } else {
-        copy_halves(twist_[node.parent], twist);
-        copy_halves(spatial_bias_[node.parent], bias);
-        const int inherited = num_columns(node.parent);
-        for (int i = 0; i < static_cast<int>(node.screws.size()); ++i) {
-          const Vector6& xi = spatial_column(b, inherited + i);
-          const double rate = v_[node.v_offset + i];
-          add_motion(xi, rate, twist, bias);
+        for (int k = 0; k < count; ++k) {
+          const bool turns = node.screws[k].kind == Screw::Kind::rotation;
+          state.motion.col(k).head<3>() = turns ? axis[k] : Eigen::Vector3d::Zero();
+          state.motion.col(k).tail<3>() =
+              turns ? Eigen::Vector3d(axis[k].cross(frame.position - point[k])) : axis[k];
         }
-        frame.angular_velocity = frame.rotation.transpose() * twist.head<3>();
-        frame.linear_velocity = twist.tail<3>() + twist.head<3>().cross(frame.position);
       }
-      store_motion(b, frame, twist, bias);
+      state.offset = frame.position - parent.position;
     }
+    update_velocities();
   }
 
-  /// Keeps body b's twist and bias acceleration (global, at the origin), and its bias c in its
-  /// own velocity coordinates: the centre's acceleration v_O' + omega' x x + omega x v_centre,
-  /// and R^T omega'.
-  void store_motion(int b, const Frame& frame, const Vector6& twist, const Vector6& bias) {
-    copy_halves(twist, twist_[b]);
-    copy_halves(bias, spatial_bias_[b]);
-    bias_.segment<3>(6 * (b - 1)) = bias.tail<3>() + bias.head<3>().cross(frame.position) +
-                                    twist.head<3>().cross(frame.linear_velocity);
-    bias_.segment<3>(6 * (b - 1) + 3) = frame.rotation.transpose() * bias.head<3>();
+  /// Down the tree: twists V = V_parent (at this centre) + S theta', the joints' c and the
+  /// frames' velocities, with the frames and columns of the last update_kinematics. c is
+  /// sum_k (V_k-1 x S_k) theta'_k for a product of exponentials (S_k is carried by the motions
+  /// before it), V_parent x S theta' for a ball joint (S is carried by the child), and
+  /// (0, v_centre x omega) for a free root (its translations are the ground's).
+  void update_velocities() {
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const TreeBody& node = tree_[i];
+      detail::TreeNodeState& state = nodes_[i];
+      Frame& frame = ws_.frames[node.body];
+      Vector6 twist = node.parent_node >= 0
+                          ? shifted_motion(nodes_[node.parent_node].twist, state.offset)
+                          : Vector6::Zero();
+      state.bias.setZero();
+      const auto rates = v_.segment(node.v_offset, node.dof());
+      if (node.kind == Kind::free) {
+        twist.noalias() = state.motion * rates;
+        state.bias.tail<3>() = twist.tail<3>().cross(twist.head<3>());
+      } else if (node.kind == Kind::ball) {
+        const Vector6 relative = state.motion.leftCols<3>() * rates;
+        state.bias = motion_cross(twist, relative);
+        twist += relative;
+      } else {
+        for (int k = 0; k < node.dof(); ++k) {
+          const Vector6 column = state.motion.col(k);
+          state.bias += motion_cross(twist, column) * rates[k];
+          twist += column * rates[k];
+        }
+      }
+      state.twist = twist;
+      frame.angular_velocity.noalias() = frame.rotation.transpose() * twist.head<3>();
+      frame.linear_velocity = twist.tail<3>();
+    }
   }
 
   const Model& model_;
   Workspace<Model>& ws_;
   std::vector<TreeBody> tree_;  // parents before children
+  std::vector<int> node_of_;    // body index -> place in tree_ (-1: the ground)
   std::array<std::vector<Closure>, Model::num_types> closures_;
+  std::vector<detail::ClosureBlock> closure_blocks_;
   std::vector<std::string> tree_names_, closure_names_;
 
-  // Per body (index 0: the ground): the coordinates that move it, where its columns start in
-  // the flat arrays of columns, its twist V_b and its spatial acceleration at rest.
-  std::vector<std::vector<Eigen::Index>> columns_;
-  std::vector<int> first_column_;
-  std::vector<Vector6> spatial_columns_, body_columns_;  // of S_b (twists), of J_b
-  std::vector<Vector6> twist_, spatial_bias_;
+  std::vector<detail::TreeNodeState> nodes_;
+  std::vector<Vector6> force_;             // per node: p in a solve (scratch)
+  std::vector<Vector6> motion_, motion2_;  // per node: J x (+ c) of a solve (scratch)
+  std::vector<Vector6> closure_motion_;    // per node: saddle_solve's own scratch
 
   Eigen::VectorXd q_, v_;             // (nq), (n) joint coordinates and rates
-  Eigen::VectorXd bias_;              // (6 nb) c
   Eigen::VectorXd constraint_force_;  // (6 nb) Phi_q^T lambda, in complete_workspace()
   Eigen::VectorXd phi_, phi_t_;       // (m) of the closures
-  Eigen::MatrixXd kkt_;               // (n + m) [J^T M J  C^T; C  0], lower triangle
+  Eigen::VectorXd closure_rhs_;       // (m) a saddle-point solve's s
+  Eigen::VectorXd multiplier_;        // (m) scratch
+  Eigen::MatrixXd schur_;             // (m x m) C A^-1 C^T
+  bool dense_ = false;                // small: the whole saddle-point matrix (dense_limit)
+  Eigen::MatrixXd kkt_;               // (n + m) [A C^T; C 0], lower triangle (dense_)
   SaddlePointLdlt kkt_ldlt_;
-  Eigen::VectorXd solution_;      // (n + m) right-hand side, then solution
-  Eigen::VectorXd increment_;     // (n) a position error in rate coordinates
-  Eigen::VectorXd qdd_, lambda_;  // (n), (m) of the last solve_accelerations
+  Eigen::VectorXd solution_;  // (n + m) right-hand side, then solution (dense_)
+  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
+  Eigen::VectorXd increment_, increment2_;  // (n) scratch
+  Eigen::VectorXd closure_step_;            // (n) saddle_solve's own scratch
+  Eigen::VectorXd qdd_, lambda_;            // (n), (m) of the last solve_accelerations
 };
 
 }  // namespace odyn

@@ -5,7 +5,8 @@
 //     g(theta) = exp(xi_1 theta_1) exp(xi_2 theta_2) ... g(0),
 // each xi a rotation about an axis through a point, or a translation along an axis, all given in
 // the parent body's coordinates at the pose where every theta is 0 (the assembled start). The
-// joint's own equations then hold for every theta by construction.
+// joint's own equations then hold for every theta by construction. A ball joint (BallTreeJoint)
+// turns its child freely about a point instead: a quaternion, not a product of exponentials.
 
 #include <Eigen/Core>
 #include <array>
@@ -30,5 +31,16 @@ concept TreeJoint = Constraint<E> && requires(const E& e, const InputOf<E>& in) 
   { E::degrees_of_freedom } -> std::convertible_to<int>;
   { e.tree_screws(in, 0) } -> std::same_as<std::array<Screw, E::degrees_of_freedom>>;
 };
+
+/// A joint that lets its child turn freely about one point, given (by `tree_pivot`) in the
+/// coordinates of the body at `parent_side`: a spherical joint as a tree joint.
+template <class E>
+concept BallTreeJoint = Constraint<E> && requires(const E& e, const InputOf<E>& in) {
+  { e.tree_pivot(in, 0) } -> std::convertible_to<Eigen::Vector3d>;
+};
+
+/// A joint that can carry a body in a joint-coordinate tree.
+template <class E>
+concept CarriesBody = TreeJoint<E> || BallTreeJoint<E>;
 
 }  // namespace odyn::spatial

@@ -3,6 +3,7 @@
 
 #include "odyn/spatial/pair_joint.hpp"
 #include "odyn/spatial/primitives.hpp"
+#include "odyn/spatial/screw.hpp"
 
 namespace odyn::spatial {
 
@@ -14,6 +15,11 @@ class Spherical : public PairJoint {
             const Eigen::Vector3d& point_b)
       : PairJoint(std::move(name), body_a, JointFrame{point_a}, body_b, JointFrame{point_b}) {}
 
+  /// As a tree joint: the child turns freely about the parent's joint point.
+  Eigen::Vector3d tree_pivot(const Input&, int parent_side) const {
+    return frame(parent_side).point;
+  }
+
   void evaluate(const Input& in, BlocksOf<Spherical>& out) const {
     primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
     out.phi_t.setZero();
@@ -24,5 +30,6 @@ class Spherical : public PairJoint {
   }
 };
 static_assert(Constraint<Spherical>);
+static_assert(BallTreeJoint<Spherical>);
 
 }  // namespace odyn::spatial
