@@ -3,11 +3,11 @@
 // own blocks of M v' + Phi_q^T lambda = Q, Phi(q, t) = 0. One include for everything.
 
 #include "odyn/analysis/assembly.hpp"
-#include "odyn/analysis/dynamics.hpp"
 #include "odyn/analysis/reactions.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/model.hpp"
 #include "odyn/core/workspace.hpp"
+#include "odyn/dynamics.hpp"
 #include "odyn/integrators/generalized_alpha.hpp"
-#include "odyn/spatial.hpp"
 #include "odyn/planar.hpp"
+#include "odyn/spatial.hpp"

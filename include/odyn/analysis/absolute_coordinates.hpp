@@ -9,10 +9,10 @@
 #include <Eigen/Core>
 
 #include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
-#include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
 

@@ -7,7 +7,7 @@
 //  3. accelerations and multipliers from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma].
 // Redundant constraint equations are reported by name (they make lambda non-unique).
 // A mechanism whose redundant equations are consistent (Bricard's linkage, two coaxial hinges)
-// assembles and runs: the solvers give the minimum-norm multipliers (linalg/saddle_point.hpp),
+// assembles and runs: the solvers give the minimum-norm multipliers (analysis/saddle_point.hpp),
 // and redundant_equations(model, ws) says which equations repeat others.
 
 #include <Eigen/Core>

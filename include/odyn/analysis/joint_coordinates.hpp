@@ -448,6 +448,13 @@ class JointCoordinates {
     return out;
   }
 
+  /// into += a wrench at a child's centre moved to its parent's: torque plus r x force.
+  static void add_shifted_force(const Vector6& force, const Eigen::Vector3d& offset,
+                                Vector6& into) {
+    into.head<3>() += force.head<3>() + offset.cross(force.tail<3>());
+    into.tail<3>() += force.tail<3>();
+  }
+
   /// (omega, v) x (omega', v') = (omega x omega', omega x v' + v x omega').
   static Vector6 motion_cross(const Vector6& a, const Vector6& b) {
     Vector6 out;
@@ -554,10 +561,7 @@ class JointCoordinates {
                           (node.inverse_pivot.template topLeftCorner<K, K>() * u);
     }
     const int parent = tree_[i].parent_node;
-    if (parent >= 0) {
-      force_[parent].head<3>() += handed.head<3>() + node.offset.cross(handed.tail<3>());
-      force_[parent].tail<3>() += handed.tail<3>();
-    }
+    if (parent >= 0) add_shifted_force(handed, node.offset, force_[parent]);
     return true;
   }
 
@@ -644,11 +648,8 @@ class JointCoordinates {
         const TreeBody& node = tree_[i];
         for (int k = 0; k < node.dof(); ++k)
           solution_[node.v_offset + k] = -nodes_[i].motion.col(k).dot(force_[i]);
-        if (node.parent_node >= 0) {
-          Vector6& into = force_[node.parent_node];
-          into.head<3>() += force_[i].head<3>() + nodes_[i].offset.cross(force_[i].tail<3>());
-          into.tail<3>() += force_[i].tail<3>();
-        }
+        if (node.parent_node >= 0)
+          add_shifted_force(force_[i], nodes_[i].offset, force_[node.parent_node]);
       }
     } else {
       solution_.head(n).setZero();
@@ -898,11 +899,8 @@ class JointCoordinates {
         const TreeBody& node = tree_[i];
         jacobian.row(j).segment(node.v_offset, node.dof()) =
             (nodes_[i].motion.leftCols(node.dof()).transpose() * force_[i]).transpose();
-        if (node.parent_node >= 0) {
-          Vector6& into = force_[node.parent_node];
-          into.head<3>() += force_[i].head<3>() + nodes_[i].offset.cross(force_[i].tail<3>());
-          into.tail<3>() += force_[i].tail<3>();
-        }
+        if (node.parent_node >= 0)
+          add_shifted_force(force_[i], nodes_[i].offset, force_[node.parent_node]);
       }
     }
     Eigen::FullPivLU<Eigen::MatrixXd> lu(jacobian);

@@ -14,7 +14,7 @@
 //
 // A singular matrix (redundant constraints) falls back to a dense complete orthogonal
 // decomposition, which gives the minimum-norm multipliers as the dense solvers do
-// (linalg/saddle_point.hpp) but costs O((n + m)^3): large over-constrained models are not on
+// (analysis/saddle_point.hpp) but costs O((n + m)^3): large over-constrained models are not on
 // the linear-cost path yet.
 
 #include <Eigen/Core>

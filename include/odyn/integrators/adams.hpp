@@ -29,12 +29,12 @@
 #include <string>
 
 #include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/integrator.hpp"
 #include "odyn/linalg/all_finite.hpp"
-#include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
 

@@ -41,13 +41,13 @@
 
 #include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/diagnosis.hpp"
+#include "odyn/analysis/minimum_norm.hpp"
+#include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
 #include "odyn/linalg/all_finite.hpp"
-#include "odyn/linalg/minimum_norm.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
-#include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
 

@@ -27,11 +27,11 @@
 #include <string>
 
 #include "odyn/analysis/absolute_coordinates.hpp"
+#include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/integrator.hpp"
 #include "odyn/linalg/all_finite.hpp"
-#include "odyn/linalg/saddle_point.hpp"
 
 namespace odyn {
 

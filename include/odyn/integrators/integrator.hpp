@@ -1,5 +1,5 @@
 #pragma once
-// What every time integrator provides, so that one driver (analysis/dynamics.hpp) runs any of
+// What every time integrator provides, so that one driver (odyn/dynamics.hpp) runs any of
 // them, lands on output times and ends steps exactly on the switches of force laws.
 //
 // An integrator owns the committed state (time t_n and whatever history it keeps) and writes

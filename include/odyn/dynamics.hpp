@@ -64,7 +64,7 @@ struct RunSummary {
   double max_velocity_residual = 0.0;  // max |Phi_q v + Phi_t| at the output times
   /// Constraint equations that repeat others at the assembled pose (Phi_q rank-deficient): the
   /// run goes on with the minimum-norm multipliers, and the reactions of these joints are then
-  /// one choice among many (see linalg/saddle_point.hpp). Empty for an ordinary mechanism.
+  /// one choice among many (see analysis/saddle_point.hpp). Empty for an ordinary mechanism.
   std::vector<RedundantEquation> redundant_equations;
 };
 
