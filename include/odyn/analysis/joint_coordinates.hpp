@@ -31,8 +31,8 @@
 // articulated inertia, its joint's pivot block D = S^T I^A S) and solves A x = J^T w for any
 // wrenches w in one pass up (the forces a subtree hands its parent) and one pass down (the
 // accelerations): O(N) for N bodies, whatever the shape of the tree. The closures go through
-// their Schur complement S = C A^-1 C^T (m x m, dense, from m tree solves at each
-// factorization), so that each saddle-point solve is two tree solves and one solve with S; the
+// their Schur complement C A^-1 C^T (m x m, dense, from m tree solves at each factorization),
+// so that each saddle-point solve is two tree solves and one solve with that complement; the
 // cost is O(N (1 + m)): linear for trees and for models with few loops, while models with many
 // loops (a ladder of four-bars) are better run in absolute coordinates. Models of a few bodies
 // (up to dense_limit unknowns, the engine among them) form the saddle-point matrix instead (A
