@@ -246,31 +246,22 @@ void advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
 }
 
 namespace detail {
-/// Each integrator's own settings, taken from the analysis settings.
+/// Each integrator's own settings, taken from the analysis settings: its own member of them,
+/// with the analysis's linear solver.
 template <class Settings>
-Settings integrator_settings(const DynamicsSettings& s);
-template <>
-inline GeneralizedAlphaSettings integrator_settings(const DynamicsSettings& s) {
-  GeneralizedAlphaSettings settings = s.generalized_alpha;
-  settings.hht = settings.hht || s.integrator == "hht";
-  settings.linear_solver = s.linear_solver;
-  return settings;
-}
-template <>
-inline DormandPrinceSettings integrator_settings(const DynamicsSettings& s) {
-  DormandPrinceSettings settings = s.dormand_prince;
-  settings.linear_solver = s.linear_solver;
-  return settings;
-}
-template <>
-inline BdfSettings integrator_settings(const DynamicsSettings& s) {
-  BdfSettings settings = s.bdf;
-  settings.linear_solver = s.linear_solver;
-  return settings;
-}
-template <>
-inline AdamsSettings integrator_settings(const DynamicsSettings& s) {
-  AdamsSettings settings = s.adams;
+Settings integrator_settings(const DynamicsSettings& s) {
+  Settings settings;
+  if constexpr (std::is_same_v<Settings, GeneralizedAlphaSettings>) {
+    settings = s.generalized_alpha;
+    settings.hht = settings.hht || s.integrator == "hht";
+  } else if constexpr (std::is_same_v<Settings, DormandPrinceSettings>) {
+    settings = s.dormand_prince;
+  } else if constexpr (std::is_same_v<Settings, BdfSettings>) {
+    settings = s.bdf;
+  } else {
+    static_assert(std::is_same_v<Settings, AdamsSettings>, "an integrator without settings here");
+    settings = s.adams;
+  }
   settings.linear_solver = s.linear_solver;
   return settings;
 }

@@ -306,7 +306,7 @@ class JointCoordinates {
 
   /// Removes C theta' + Phi_t, least change in A.
   void correct_velocities() {
-    closure_rates(twist_view(), closure_rhs_);
+    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);
     closure_rhs_ = -(closure_rhs_ + phi_t_);
     saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
     v_ += increment_;
@@ -659,12 +659,17 @@ class JointCoordinates {
     mu = solution_.tail(num_equations());
   }
 
-  /// The closures' rates G V for the bodies' motions V (twists or accelerations).
-  void closure_rates(const std::vector<Vector6>& motion, Eigen::Ref<Eigen::VectorXd> out) const {
+  /// The closures' rates G V for the bodies' motions V (twists or accelerations), V of node i
+  /// being motion(i).
+  template <class Motion>
+  void closure_rates_of(Motion&& motion, Eigen::Ref<Eigen::VectorXd> out) const {
     out.setZero();
     for (const detail::ClosureBlock& block : closure_blocks_)
       for (int r = 0; r < block.count; ++r)
-        out[block.row + r] += block.rows.row(r).dot(motion[block.node]);
+        out[block.row + r] += block.rows.row(r).dot(motion(block.node));
+  }
+  void closure_rates(const std::vector<Vector6>& motion, Eigen::Ref<Eigen::VectorXd> out) const {
+    closure_rates_of([&](int i) -> const Vector6& { return motion[i]; }, out);
   }
 
   /// force += sign C^T lambda, as wrenches (global axes, at the centres).
@@ -677,12 +682,6 @@ class JointCoordinates {
 
   static void clear(std::vector<Vector6>& vectors) {
     for (Vector6& v : vectors) v.setZero();
-  }
-
-  /// The bodies' twists, as the closures read them.
-  std::vector<Vector6>& twist_view() {
-    for (std::size_t i = 0; i < tree_.size(); ++i) motion2_[i] = nodes_[i].twist;
-    return motion2_;
   }
 
   /// f(element, blocks, closure_row, model_row) for every loop-closing constraint element.
