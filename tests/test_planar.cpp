@@ -167,6 +167,31 @@ void check_against_differences(const Scene& s) {
   const Eigen::Matrix<double, m, 1> gamma = joint.gamma(f.input(kTime));
   INFO(joint.name() << " gamma " << gamma.transpose() << " vs " << -rate.transpose());
   CHECK((gamma + rate).norm() < 1e-6 * (1.0 + gamma.norm()));
+  // Geometric stiffness: body k's block is d(J_k^T lambda)/d(q_k).
+  if constexpr (odyn::HasGeometricStiffness<E>) {
+    const Eigen::Matrix<double, m, 1> lambda = Eigen::Matrix<double, m, 1>::LinSpaced(m, 3.0, -2.0);
+    odyn::GeometricStiffness<Space, 2> analytic;
+    for (auto& block : analytic) block.setZero();
+    f.set(s.q_a, s.v_a, s.q_b, s.v_b);
+    joint.add_geometric_stiffness(f.input(kTime), lambda, analytic);
+    for (int side = s.ground_a ? 1 : 0; side < 2; ++side) {
+      Eigen::Matrix3d numeric;
+      for (int j = 0; j < 3; ++j) {
+        Vector3d dq = Vector3d::Zero();
+        dq[j] = eps;
+        const auto share = [&](double sign) {
+          const Blocks out = blocks_at(side == 0 ? Vector3d(s.q_a + sign * dq) : s.q_a,
+                                       side == 1 ? Vector3d(s.q_b + sign * dq) : s.q_b, kTime);
+          return Vector3d(out.jacobian[side].transpose() * lambda);
+        };
+        numeric.col(j) = (share(1.0) - share(-1.0)) / (2.0 * eps);
+      }
+      INFO(joint.name() << " geometric stiffness, side " << side << "\n"
+                        << analytic[side] << "\nnumeric\n"
+                        << numeric);
+      CHECK((analytic[side] - numeric).norm() < 1e-7 * (1.0 + numeric.norm()));
+    }
+  }
 }
 
 }  // namespace

@@ -39,6 +39,7 @@
 // Cholesky of S (the block Schur solver) or LU (the dense one); the rank-revealing
 // factorizations run only when that path finds a singular matrix.
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/LU>  // inverse() of the small fixed-size body blocks
 #include <algorithm>
@@ -85,7 +86,7 @@ class DenseSaddlePoint {
   /// matrix holds non-finite values.
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     matrix_.setZero();
-    add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping);
+    add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping, f.geometric);
     write_jacobian(model, ws, matrix_, n_, 0, true);
     rank_deficiency_ = 0;
     if (lu_.factorize(matrix_)) return true;
@@ -145,6 +146,44 @@ Eigen::Matrix<double, N, N> invert_symmetric(const Eigen::Matrix<double, N, N>& 
   }
 }
 
+/// True if the symmetric 3 x 3 matrix a is positive definite (its leading minors).
+inline bool positive_definite(const Eigen::Matrix3d& a) {
+  return a(0, 0) > 0.0 && a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0) > 0.0 && a.determinant() > 0.0;
+}
+
+/// inverse = a^-1 if the symmetric a is positive definite; false (inverse unspecified) if not.
+/// The 6 x 6 case is invert_symmetric's, with its two 3 x 3 pivots checked on the way.
+template <int N>
+bool invert_positive_definite(const Eigen::Matrix<double, N, N>& a,
+                              Eigen::Matrix<double, N, N>& inverse) {
+  if constexpr (N == 6) {
+    const Eigen::Matrix3d p = a.template topLeftCorner<3, 3>();
+    if (!positive_definite(p)) return false;
+    const Eigen::Matrix3d p_inverse = p.inverse();
+    const Eigen::Matrix3d q = a.template topRightCorner<3, 3>();
+    const Eigen::Matrix3d p_inverse_q = p_inverse * q;
+    const Eigen::Matrix3d schur =
+        a.template bottomRightCorner<3, 3>() - q.transpose() * p_inverse_q;
+    if (!positive_definite(schur)) return false;
+    const Eigen::Matrix3d schur_inverse = schur.inverse();
+    inverse.template topRightCorner<3, 3>() = -p_inverse_q * schur_inverse;
+    inverse.template topLeftCorner<3, 3>() =
+        p_inverse - inverse.template topRightCorner<3, 3>() * p_inverse_q.transpose();
+    inverse.template bottomLeftCorner<3, 3>() = inverse.template topRightCorner<3, 3>().transpose();
+    inverse.template bottomRightCorner<3, 3>() = schur_inverse;
+    return true;
+  } else if constexpr (N == 3) {
+    if (!positive_definite(a)) return false;
+    inverse = a.inverse();
+    return true;
+  } else {
+    const Eigen::LLT<Eigen::Matrix<double, N, N>> cholesky(a);
+    if (cholesky.info() != Eigen::Success) return false;
+    inverse = cholesky.solve(Eigen::Matrix<double, N, N>::Identity());
+    return true;
+  }
+}
+
 /// Lets add_iteration_blocks write into per-body diagonal blocks.
 template <int nv>
 struct BlockDiagonalView {
@@ -195,6 +234,7 @@ class BlockSchurSaddlePoint {
     n_ = model.num_velocities();
     m_ = model.num_equations();
     blocks_.assign(bodies_, Block::Zero());
+    if (has_geometric_stiffness<Model>()) geometric_.assign(bodies_, Block::Zero());
     inverses_.assign(bodies_, Block::Zero());
     diagonal_inverse_.assign(bodies_, false);
     cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
@@ -290,6 +330,15 @@ class BlockSchurSaddlePoint {
   /// |A_sym^-1 A_skew| of the last factorization (largest over the bodies): what the Schur
   /// paths compare with max_dropped_skew.
   double dropped_skew() const { return dropped_skew_; }
+
+  /// How much the geometric stiffness weighed in the last factorization that was asked for
+  /// it: |A^-1 G| largest over the bodies (infinity where it could not be used, or where a
+  /// whole-matrix path took it without measuring).
+  double geometric_share() const {
+    return path_ == Path::dense_kkt || path_ == Path::sparse_kkt
+               ? std::numeric_limits<double>::infinity()
+               : geometric_share_;
+  }
 
   /// The factorization the last analyze chose: "dense-schur", "cholmod-schur", "dense-lu" or
   /// "klu".
@@ -487,11 +536,34 @@ class BlockSchurSaddlePoint {
     std::fill(diagonal_inverse_.begin(), diagonal_inverse_.end(), false);
     for (Block& block : blocks_) block.setZero();
     detail::BlockDiagonalView<nv> view{&blocks_};
-    add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping);
+    add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping, false);
+    const bool geometric = has_geometric_stiffness<Model>() && f.geometric && f.stiffness != 0.0;
+    geometric_share_ = 0.0;
+    if (geometric) {
+      for (Block& block : geometric_) block.setZero();
+      detail::BlockDiagonalView<nv> geometric_view{&geometric_};
+      add_geometric_stiffness(model, ws, geometric_view, f.stiffness);
+    }
     for (int b = 0; b < bodies_; ++b) {
       // Gyroscopic damping makes A unsymmetric; Cholesky needs its symmetric part, which
       // slows Newton's convergence (never its result) by about |A_sym^-1 A_skew| a step.
-      inverses_[b] = detail::invert_symmetric<nv>(0.5 * (blocks_[b] + blocks_[b].transpose()));
+      // The constraints' geometric stiffness joins it where it keeps that part positive
+      // definite (large compressive forces against mass over the step squared would not).
+      const Block symmetric = 0.5 * (blocks_[b] + blocks_[b].transpose());
+      if (geometric) {
+        const Block with_geometric = symmetric + 0.5 * (geometric_[b] + geometric_[b].transpose());
+        if (detail::invert_positive_definite<nv>(with_geometric, inverses_[b])) {
+          blocks_[b] += geometric_[b];
+          geometric_share_ =
+              std::max(geometric_share_,
+                       (inverses_[b] * geometric_[b]).cwiseAbs().rowwise().sum().maxCoeff());
+        } else {
+          inverses_[b] = detail::invert_symmetric<nv>(symmetric);
+          geometric_share_ = std::numeric_limits<double>::infinity();
+        }
+      } else {
+        inverses_[b] = detail::invert_symmetric<nv>(symmetric);
+      }
       if (!inverses_[b].allFinite()) return false;
       if (!mass_only) {
         const Block skew = 0.5 * (blocks_[b] - blocks_[b].transpose());
@@ -566,6 +638,8 @@ class BlockSchurSaddlePoint {
   Path path_ = Path::dense_schur;
   Whole whole_ = Whole::none;  // the last factorization took the whole matrix
   bool whole_dense_analyzed_ = false, whole_sparse_analyzed_ = false;
+  std::vector<Block> geometric_;   // the stiffness factor times G, per body (scratch)
+  double geometric_share_ = 0.0;   // see geometric_share()
   double dropped_skew_ = 0.0;      // max over the bodies of |A_sym^-1 A_skew| (infinity norm)
   DenseSaddlePoint<Model> dense_;  // path dense_kkt
   SparseKktSaddlePoint<Model> sparse_kkt_;  // path sparse_kkt

@@ -27,11 +27,14 @@
 
 namespace odyn {
 
-/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block.
+/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block, and whether the
+/// stiffness term also holds the constraints' geometric stiffness G = d(Phi_q^T lambda)/dq
+/// (see add_geometric_stiffness).
 struct IterationFactors {
   double mass = 1.0;
   double stiffness = 0.0;
   double damping = 0.0;
+  bool geometric = false;
 };
 
 template <class Model>
@@ -73,7 +76,7 @@ class SparseKktSaddlePoint {
   /// complete orthogonal decomposition. False only if the matrix holds non-finite values.
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     matrix_.set_zero();
-    add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping);
+    add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping, f.geometric);
     write_jacobian(model, ws, matrix_, n_, 0, true);
     const std::vector<double>& values = matrix_.gather();
     rank_deficiency_ = 0;

@@ -158,11 +158,50 @@ void write_jacobian(const Model& model, const Workspace<Model>& ws, Matrix& targ
   });
 }
 
-/// target(0:n, 0:n) += mass_factor M + stiffness_factor K + damping_factor C, where K = -dQ/dq
-/// and C = -dQ/dv come from the force elements that provide them and the gyroscopic terms.
+/// True if some constraint type of the model provides its geometric stiffness.
+template <class Model>
+constexpr bool has_geometric_stiffness() {
+  return []<class B, class... E>(const odyn::Model<B, E...>*) {
+    return (HasGeometricStiffness<E> || ...);
+  }(static_cast<const Model*>(nullptr));
+}
+
+/// target's body blocks += factor G, G = d(Phi_q^T lambda)/dq at ws.lambda, from the
+/// constraints that provide it (the geometric stiffness; see GeometricStiffness).
+template <class Model, class Matrix>
+void add_geometric_stiffness(const Model& model, const Workspace<Model>& ws, Matrix& target,
+                             double factor) {
+  using Space = typename Model::Space;
+  constexpr int nv = Space::nv;
+  if (factor == 0.0) return;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (HasGeometricStiffness<E>) {
+      constexpr int m = E::num_equations;
+      const auto& rows = model.template rows<E>();
+      GeometricStiffness<Space, E::num_bodies> blocks;
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        for (auto& block : blocks) block.setZero();
+        const Eigen::Matrix<double, m, 1> lambda = ws.lambda.template segment<m>(rows[i]);
+        pool[i].add_geometric_stiffness(detail::input_of(pool[i], ws.frames, ws.t), lambda, blocks);
+        for (int k = 0; k < E::num_bodies; ++k) {
+          const BodyId body = pool[i].bodies()[k];
+          if (body.is_ground()) continue;
+          const int offset = Model::velocity_offset(body);
+          target.template block<nv, nv>(offset, offset) += factor * blocks[k];
+        }
+      }
+    }
+  });
+}
+
+/// target(0:n, 0:n) += mass_factor M + stiffness_factor (K + G) + damping_factor C, where
+/// K = -dQ/dq and C = -dQ/dv come from the force elements that provide them and the
+/// gyroscopic terms, and G = d(Phi_q^T lambda)/dq from the constraints if `geometric`
+/// (add_geometric_stiffness).
 template <class Model, class Matrix>
 void add_iteration_blocks(const Model& model, const Workspace<Model>& ws, Matrix& target,
-                          double mass_factor, double stiffness_factor, double damping_factor) {
+                          double mass_factor, double stiffness_factor, double damping_factor,
+                          bool geometric = false) {
   using Space = typename Model::Space;
   constexpr int nv = Space::nv;
   for (int b = 1; b <= model.num_bodies(); ++b) {
@@ -172,6 +211,7 @@ void add_iteration_blocks(const Model& model, const Workspace<Model>& ws, Matrix
         damping_factor * Space::gyroscopic_damping(body.inertia, ws.frames[b]);
   }
   if (stiffness_factor == 0.0 && damping_factor == 0.0) return;
+  if (geometric) add_geometric_stiffness(model, ws, target, stiffness_factor);
   model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
     if constexpr (HasForceJacobians<E>) {
       ForceBlocksOf<E> blocks;

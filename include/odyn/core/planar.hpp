@@ -73,6 +73,14 @@ struct Planar {
       jacobian.col(2) = perpendicular(rotation * local);
       return jacobian;
     }
+    /// How point_jacobian(s)^T g, the generalized force of a fixed force g at the point,
+    /// changes with the body's velocity coordinates: its torque g . perpendicular(R s) turns
+    /// with the body, by -g . (R s).
+    MassBlock point_jacobian_derivative(const Vector& local, const Vector& global) const {
+      MassBlock derivative = MassBlock::Zero();
+      derivative(2, 2) = -global.dot(rotation * local);
+      return derivative;
+    }
     Angular global_angular_velocity() const { return angular_velocity; }
     /// Generalized force of a torque (in the plane, global and body torques are the same).
     Angular torque_to_body(const Angular& torque) const { return torque; }

@@ -62,6 +62,14 @@ struct Spatial {
       jacobian.rightCols<3>() = -rotation * skew(local);
       return jacobian;
     }
+    /// How point_jacobian(s)^T g, the generalized force of a fixed global force g at the point,
+    /// changes with the body's velocity coordinates: only its torque s x R^T g turns with the
+    /// body, by skew(s) skew(R^T g).
+    MassBlock point_jacobian_derivative(const Vector& local, const Vector& global) const {
+      MassBlock derivative = MassBlock::Zero();
+      derivative.bottomRightCorner<3, 3>() = skew(local) * skew(rotation.transpose() * global);
+      return derivative;
+    }
     /// Global angular velocity.
     Vector global_angular_velocity() const { return rotation * angular_velocity; }
     /// Generalized force of a global torque (the body velocity's angular part is body-frame).

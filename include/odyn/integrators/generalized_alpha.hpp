@@ -370,6 +370,10 @@ class GeneralizedAlpha {
         weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol, control_.atol);
   }
 
+  /// Newton contraction per iteration above which a matrix factorized at an earlier iterate is
+  /// refreshed (see solve_step).
+  static constexpr double refresh_contraction = 0.05;
+
   /// d(q_{n+1})/d(v'_{n+1}) and d(v_{n+1})/d(v'_{n+1}).
   double position_factor() const { return beta_ * h_ * h_ * (1.0 - alpha_f_) / (1.0 - alpha_m_); }
   double velocity_factor() const { return gamma_ * h_ * (1.0 - alpha_f_) / (1.0 - alpha_m_); }
@@ -377,8 +381,10 @@ class GeneralizedAlpha {
   bool factorize() {
     ++statistics_.factorizations;
     ++statistics_.jacobian_evaluations;
-    factorized_ =
-        solver_.factorize(model_, ws_, IterationFactors{1.0, position_factor(), velocity_factor()});
+    factorized_ = solver_.factorize(
+        model_, ws_, IterationFactors{1.0, position_factor(), velocity_factor(), geometric_});
+    // The geometric stiffness leaves the matrix again once it weighs too little to matter.
+    if (geometric_ && solver_.geometric_share() < 0.01) geometric_ = false;
     return factorized_;
   }
 
@@ -403,6 +409,8 @@ class GeneralizedAlpha {
     // of the tight one, whether the factorization is worth keeping is judged on these alone.
     int ordinary_iterations = 0;
     bool ordinary_met = false;
+    int refreshes = 0;
+    factorized_at_ = -1;  // the iterate of the matrix in use: before this step
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
       const double phi_norm = m_ == 0 ? 0.0 : ws_.phi.cwiseAbs().maxCoeff();
@@ -427,7 +435,10 @@ class GeneralizedAlpha {
         return true;
       }
       if (k == settings_.max_iterations) return false;
-      if (!factorized_ && !factorize()) return false;
+      if (!factorized_) {
+        if (!factorize()) return false;
+        factorized_at_ = k;
+      }
       solver_.solve(residual_, correction_);
       ws_.vdot -= correction_.head(nv_total_);
       ws_.lambda -= correction_.tail(m_);
@@ -442,6 +453,7 @@ class GeneralizedAlpha {
       }
       if (k > 0 && norm > 2.0 * previous_norm && norm * loose > 1.0) return false;  // diverging
       update_state(t_new);
+      const double rate = k > 0 ? norm / previous_norm : 0.0;
       // Newton contracts the correction by about rate = norm / previous_norm per iteration, so
       // the error left after this correction is about rate / (1 - rate) times it (Hairer &
       // Wanner, Sect. IV.8). When that is within tolerance, and Phi, extrapolated with its own
@@ -452,7 +464,6 @@ class GeneralizedAlpha {
       // calls at outputs. Redundant constraints always get the confirming evaluation: their
       // minimum-norm corrections do not contract as regularly.
       if (k > 0 && solver_.rank_deficiency() == 0) {
-        const double rate = norm / previous_norm;
         const double phi_rate = m_ == 0 ? 0.0 : phi_norm / previous_phi_norm;
         if (rate < 0.5 && rate / (1.0 - rate) * norm <= 1.0 && phi_rate < 0.5 &&
             10.0 * phi_rate * phi_norm <= settings_.constraint_tolerance) {
@@ -461,6 +472,21 @@ class GeneralizedAlpha {
           if (k + 1 > settings_.reuse_iterations) factorized_ = false;
           return true;
         }
+      }
+      // A slow contraction with a matrix factorized at an earlier iterate says that it no longer
+      // fits: the constraint forces, whose geometric stiffness it holds, have moved a good
+      // fraction (a long chain whipping round changes them by half within a step). When more
+      // than two more iterations at that rate would be needed, factorize afresh at the next
+      // iterate, at most twice a step.
+      if (rate > refresh_contraction && rate * rate * norm > 1.0 && refreshes < 2 &&
+          factorized_at_ < k) {
+        factorized_ = false;
+        ++refreshes;
+        // From then on, the matrix holds the constraints' geometric stiffness while it weighs
+        // in (see factorize): where the constraint forces are large against mass over h^2
+        // Newton needs it (without, 1/10 an iteration on that chain); elsewhere it changes
+        // nothing and costs some 10 % of a step.
+        geometric_ = has_geometric_stiffness<Model>();
       }
       earlier_norm = previous_norm;
       previous_norm = norm;
@@ -531,6 +557,8 @@ class GeneralizedAlpha {
   double t_n_ = 0.0;
   int nv_total_ = 0, m_ = 0;
   bool factorized_ = false;
+  int factorized_at_ = -1;     // Newton iterate of this step at which the matrix was factorized
+  bool geometric_ = false;     // the matrix holds the geometric stiffness (see solve_step)
   bool blocks_stale_ = false;  // the accepted state's blocks are one Newton iterate behind
 
   Eigen::VectorXd residual_;                             // (n)

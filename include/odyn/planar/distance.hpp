@@ -43,6 +43,12 @@ class Distance : public PairJoint {
         primitive::distance_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point, length_));
   }
 
+  void add_geometric_stiffness(const Input& in, const Eigen::Matrix<double, 1, 1>& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::distance_stiffness(in.body(0), on_a_.point, in.body(1), on_b_.point, length_,
+                                  lambda[0], out);
+  }
+
  private:
   double length_;
 };

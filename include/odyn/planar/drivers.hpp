@@ -76,6 +76,11 @@ class TranslationalDriver : public PairJoint {
         motion_.acceleration(in.t));
   }
 
+  void add_geometric_stiffness(const Input& in, const Eigen::Matrix<double, 1, 1>& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::on_line_stiffness(in.body(0), on_a_.axis, in.body(1), on_b_.point, lambda[0], out);
+  }
+
   const Motion& motion() const { return motion_; }
 
  private:

@@ -24,6 +24,13 @@ class Fixed : public PairJoint {
     g << primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point), 0.0;
     return g;
   }
+
+  /// The angle row is linear in the coordinates: it adds nothing.
+  void add_geometric_stiffness(const Input& in, const Eigen::Vector3d& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::coincident_stiffness(in.body(0), on_a_.point, in.body(1), on_b_.point,
+                                    lambda.head<2>(), out);
+  }
 };
 static_assert(Constraint<Fixed>);
 

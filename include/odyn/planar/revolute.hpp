@@ -20,6 +20,11 @@ class Revolute : public PairJoint {
   Eigen::Vector2d gamma(const Input& in) const {
     return primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
   }
+
+  void add_geometric_stiffness(const Input& in, const Eigen::Vector2d& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::coincident_stiffness(in.body(0), on_a_.point, in.body(1), on_b_.point, lambda, out);
+  }
 };
 static_assert(Constraint<Revolute>);
 

@@ -33,6 +33,12 @@ class Translational : public PairJoint {
             0.0};
   }
 
+  /// The angle row is linear in the coordinates: it adds nothing.
+  void add_geometric_stiffness(const Input& in, const Eigen::Vector2d& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::on_line_stiffness(in.body(0), normal(), in.body(1), on_b_.point, lambda[0], out);
+  }
+
   /// The slide: displacement of b's point along a's axis, from a's point.
   double displacement(const Input& in) const {
     return in.body(0)

@@ -39,6 +39,15 @@ class Cylindrical : public PairJoint {
         primitive::dot2_gamma(a, on_a_.v, on_a_.point, b, on_b_.point);
     return g;
   }
+
+  void add_geometric_stiffness(const Input& in, const Eigen::Vector4d& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::dot1_stiffness(a, on_a_.u, b, on_b_.w, lambda[0], out);
+    primitive::dot1_stiffness(a, on_a_.v, b, on_b_.w, lambda[1], out);
+    primitive::dot2_stiffness(a, on_a_.u, b, on_b_.point, lambda[2], out);
+    primitive::dot2_stiffness(a, on_a_.v, b, on_b_.point, lambda[3], out);
+  }
 };
 static_assert(Constraint<Cylindrical>);
 static_assert(TreeJoint<Cylindrical>);

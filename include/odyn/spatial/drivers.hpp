@@ -106,6 +106,11 @@ class TranslationalDriver : public PairJoint {
         motion_.acceleration(in.t));
   }
 
+  void add_geometric_stiffness(const Input& in, const Eigen::Matrix<double, 1, 1>& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::dot2_stiffness(in.body(0), on_a_.w, in.body(1), on_b_.point, lambda[0], out);
+  }
+
   const Motion& motion() const { return motion_; }
 
  private:

@@ -35,6 +35,14 @@ class Revolute : public PairJoint {
         primitive::dot1_gamma(a, on_a_.v, b, on_b_.w);
     return g;
   }
+
+  void add_geometric_stiffness(const Input& in, const Eigen::Matrix<double, 5, 1>& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::coincident_stiffness(a, on_a_.point, b, on_b_.point, lambda.head<3>(), out);
+    primitive::dot1_stiffness(a, on_a_.u, b, on_b_.w, lambda[3], out);
+    primitive::dot1_stiffness(a, on_a_.v, b, on_b_.w, lambda[4], out);
+  }
 };
 static_assert(Constraint<Revolute>);
 static_assert(TreeJoint<Revolute>);

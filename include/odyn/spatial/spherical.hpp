@@ -28,6 +28,11 @@ class Spherical : public PairJoint {
   Eigen::Vector3d gamma(const Input& in) const {
     return primitive::coincident_gamma(in.body(0), on_a_.point, in.body(1), on_b_.point);
   }
+
+  void add_geometric_stiffness(const Input& in, const Eigen::Vector3d& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    primitive::coincident_stiffness(in.body(0), on_a_.point, in.body(1), on_b_.point, lambda, out);
+  }
 };
 static_assert(Constraint<Spherical>);
 static_assert(BallTreeJoint<Spherical>);

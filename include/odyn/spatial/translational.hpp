@@ -40,6 +40,16 @@ class Translational : public PairJoint {
         primitive::dot1_gamma(a, on_a_.u, b, on_b_.v);
     return g;
   }
+
+  void add_geometric_stiffness(const Input& in, const Eigen::Matrix<double, 5, 1>& lambda,
+                               GeometricStiffness<Space, 2>& out) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    primitive::dot1_stiffness(a, on_a_.u, b, on_b_.w, lambda[0], out);
+    primitive::dot1_stiffness(a, on_a_.v, b, on_b_.w, lambda[1], out);
+    primitive::dot2_stiffness(a, on_a_.u, b, on_b_.point, lambda[2], out);
+    primitive::dot2_stiffness(a, on_a_.v, b, on_b_.point, lambda[3], out);
+    primitive::dot1_stiffness(a, on_a_.u, b, on_b_.v, lambda[4], out);
+  }
 };
 static_assert(Constraint<Translational>);
 static_assert(TreeJoint<Translational>);
