@@ -85,6 +85,7 @@ inline std::vector<char> independent_rows(const SparseRows& rows, double toleran
 inline std::vector<char> keepable_components(const SparseRows& rows,
                                              const std::vector<char>& independent_row,
                                              const std::vector<int>& given) {
+  if (given.empty()) return {};
   const int n = rows.num_columns;
   // Phi_q's independent rows by columns.
   std::vector<int> column_starts(static_cast<std::size_t>(n) + 1, 0);
@@ -114,7 +115,10 @@ inline std::vector<char> keepable_components(const SparseRows& rows,
   };
   std::vector<char> is_given(static_cast<std::size_t>(n), 0);
   for (const int j : given) is_given[j] = 1;
-  for (int j = 0; j < n; ++j)
+  // The components not given only span what the given ones are tested against, so their order
+  // is free: the last first, like the given ones, which on a model built from its root outwards
+  // (a tree numbered breadth first) eliminates from the leaves and keeps the fill local.
+  for (int j = n; j-- > 0;)
     if (!is_given[j]) add_column(j);
   std::vector<char> keep(given.size(), 0);
   for (std::size_t k = given.size(); k-- > 0;) keep[k] = add_column(given[k]) ? 0 : 1;
