@@ -7,7 +7,9 @@
 // chooses among four factorizations at analyze (choose(LinearSolver), see
 // linalg/linear_solver.hpp; by size and pattern when automatic):
 //  - the Schur complement, when A is block diagonal (no force element couples two moving
-//    bodies in the Newton matrix): A is inverted body by body and only the m x m complement
+//    bodies in the Newton matrix), or when the blocks that couple them weigh little against
+//    its diagonal blocks (large models; see max_dropped_coupling): A is inverted body by body
+//    and only the m x m complement
 //    S = B A^-1 B^T is factorized, dense by an envelope Cholesky (small models: several times
 //    cheaper than a whole-matrix LU) or sparse by CHOLMOD (large ones: linear cost on chains
 //    and trees). S is assembled from the elements' own Jacobian blocks in the workspace, one
@@ -184,14 +186,16 @@ bool invert_positive_definite(const Eigen::Matrix<double, N, N>& a,
   }
 }
 
-/// Lets add_iteration_blocks write into per-body diagonal blocks.
+/// Lets add_iteration_blocks write into per-body diagonal blocks, and the blocks that join two
+/// bodies (force elements between moving bodies) into a per-body sum, if `couplings` is given.
 template <int nv>
 struct BlockDiagonalView {
   std::vector<Eigen::Matrix<double, nv, nv>>* blocks;
+  std::vector<Eigen::Matrix<double, nv, nv>>* couplings = nullptr;
   template <int R, int C>
-  Eigen::Matrix<double, nv, nv>& block(Eigen::Index row, Eigen::Index) {
+  Eigen::Matrix<double, nv, nv>& block(Eigen::Index row, Eigen::Index column) {
     static_assert(R == nv && C == nv);
-    return (*blocks)[row / nv];
+    return row == column || couplings == nullptr ? (*blocks)[row / nv] : (*couplings)[row / nv];
   }
 };
 }  // namespace detail
@@ -218,6 +222,13 @@ class BlockSchurSaddlePoint {
   /// Newton would crawl or fail, and that factorization takes the whole matrix instead.
   static constexpr double max_dropped_skew = 0.25;
 
+  /// Largest Newton contraction, estimated body by body as |A_b^-1 sum_j A_bj|, that the Schur
+  /// complement of a large model may cost by leaving out the blocks by which force elements
+  /// couple two bodies. Springs and dampers soft against mass over the step squared (the
+  /// scaling report's rope: 5e-5) keep the Schur path; stiffer ones take the whole matrix for
+  /// that factorization.
+  static constexpr double max_dropped_coupling = 0.01;
+
   void analyze(const Model& model) {
     path_ = choose_path(model);
     whole_ = Whole::none;
@@ -234,6 +245,8 @@ class BlockSchurSaddlePoint {
     n_ = model.num_velocities();
     m_ = model.num_equations();
     blocks_.assign(bodies_, Block::Zero());
+    coupled_ = detail::couples_bodies(model);
+    if (coupled_) body_couplings_.assign(bodies_, Block::Zero());
     if (has_geometric_stiffness<Model>()) geometric_.assign(bodies_, Block::Zero());
     inverses_.assign(bodies_, Block::Zero());
     diagonal_inverse_.assign(bodies_, false);
@@ -305,7 +318,9 @@ class BlockSchurSaddlePoint {
     if (path_ == Path::sparse_kkt) return sparse_kkt_.factorize(model, ws, f);
     if (!invert_blocks(model, ws, f)) return false;
     whole_ = Whole::none;
-    if (dropped_skew_ > max_dropped_skew) return factorize_whole(model, ws, f);
+    if (dropped_skew_ + dropped_coupling_ > max_dropped_skew ||
+        dropped_coupling_ > max_dropped_coupling)
+      return factorize_whole(model, ws, f);
     if (path_ == Path::sparse_schur) {
       sparse_schur_.set_zero();
       assemble_schur(ws, sparse_schur_);
@@ -330,6 +345,16 @@ class BlockSchurSaddlePoint {
   /// |A_sym^-1 A_skew| of the last factorization (largest over the bodies): what the Schur
   /// paths compare with max_dropped_skew.
   double dropped_skew() const { return dropped_skew_; }
+
+  /// |A_b^-1 sum_j A_bj| of the last factorization (largest over the bodies): the weight of the
+  /// blocks that couple bodies, which the Schur paths compare with max_dropped_coupling.
+  double dropped_coupling() const { return dropped_coupling_; }
+
+  /// True if the last factorization took the whole matrix (a Schur path's fallback, or a
+  /// whole-matrix path).
+  bool whole_matrix() const {
+    return path_ == Path::dense_kkt || path_ == Path::sparse_kkt || whole_ != Whole::none;
+  }
 
   /// How much the geometric stiffness weighed in the last factorization that was asked for
   /// it: |A^-1 G| largest over the bodies (infinity where it could not be used, or where a
@@ -420,8 +445,9 @@ class BlockSchurSaddlePoint {
     return sparse_kkt_.factorize(model, ws, f);
   }
 
-  /// What to factorize: the Schur complement needs A block diagonal (no force element's Newton
-  /// blocks join two moving bodies).
+  /// What to factorize: the Schur complement needs A block diagonal, or nearly (force elements
+  /// that join two moving bodies: small models take the whole matrix, large ones the Schur
+  /// complement while the couplings weigh little; see max_dropped_coupling).
   Path choose_path(const Model& model) const {
     const bool coupled = detail::couples_bodies(model);
     switch (choice_) {
@@ -437,10 +463,8 @@ class BlockSchurSaddlePoint {
                            "bodies; choose klu (or auto) for this model");
         return Path::sparse_schur;
       default:
-        if (coupled)
-          return model.num_velocities() + model.num_equations() <= dense_kkt_limit
-                     ? Path::dense_kkt
-                     : Path::sparse_kkt;
+        if (coupled && model.num_velocities() + model.num_equations() <= dense_kkt_limit)
+          return Path::dense_kkt;
         return model.num_equations() <= dense_schur_limit ? Path::dense_schur : Path::sparse_schur;
     }
   }
@@ -530,12 +554,13 @@ class BlockSchurSaddlePoint {
   /// assembly) A is a multiple of the constant mass matrix: its inverses are kept and reused.
   bool invert_blocks(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     const bool mass_only = f.stiffness == 0.0 && f.damping == 0.0;
-    dropped_skew_ = 0.0;  // M is symmetric
+    dropped_skew_ = dropped_coupling_ = 0.0;  // M is symmetric and block diagonal
     if (mass_only && f.mass == cached_mass_factor_) return true;
     cached_mass_factor_ = std::numeric_limits<double>::quiet_NaN();
     std::fill(diagonal_inverse_.begin(), diagonal_inverse_.end(), false);
     for (Block& block : blocks_) block.setZero();
-    detail::BlockDiagonalView<nv> view{&blocks_};
+    for (Block& block : body_couplings_) block.setZero();
+    detail::BlockDiagonalView<nv> view{&blocks_, coupled_ ? &body_couplings_ : nullptr};
     add_iteration_blocks(model, ws, view, f.mass, f.stiffness, f.damping, false);
     const bool geometric = has_geometric_stiffness<Model>() && f.geometric && f.stiffness != 0.0;
     geometric_share_ = 0.0;
@@ -569,6 +594,10 @@ class BlockSchurSaddlePoint {
         const Block skew = 0.5 * (blocks_[b] - blocks_[b].transpose());
         dropped_skew_ =
             std::max(dropped_skew_, (inverses_[b] * skew).cwiseAbs().rowwise().sum().maxCoeff());
+        if (coupled_)
+          dropped_coupling_ =
+              std::max(dropped_coupling_,
+                       (inverses_[b] * body_couplings_[b]).cwiseAbs().rowwise().sum().maxCoeff());
       }
     }
     if (mass_only) {
@@ -638,10 +667,13 @@ class BlockSchurSaddlePoint {
   Path path_ = Path::dense_schur;
   Whole whole_ = Whole::none;  // the last factorization took the whole matrix
   bool whole_dense_analyzed_ = false, whole_sparse_analyzed_ = false;
-  std::vector<Block> geometric_;   // the stiffness factor times G, per body (scratch)
-  double geometric_share_ = 0.0;   // see geometric_share()
-  double dropped_skew_ = 0.0;      // max over the bodies of |A_sym^-1 A_skew| (infinity norm)
-  DenseSaddlePoint<Model> dense_;  // path dense_kkt
+  std::vector<Block> geometric_;       // the stiffness factor times G, per body (scratch)
+  double geometric_share_ = 0.0;       // see geometric_share()
+  double dropped_skew_ = 0.0;          // max over the bodies of |A_sym^-1 A_skew| (infinity norm)
+  bool coupled_ = false;               // force elements join moving bodies in A
+  std::vector<Block> body_couplings_;  // (nb) sum of A's off-diagonal blocks in each body's rows
+  double dropped_coupling_ = 0.0;      // max over the bodies of |A_b^-1 body_couplings_[b]|
+  DenseSaddlePoint<Model> dense_;      // path dense_kkt
   SparseKktSaddlePoint<Model> sparse_kkt_;  // path sparse_kkt
   int bodies_ = 0, n_ = 0, m_ = 0;
   Method method_ = Method::cholesky;
