@@ -99,6 +99,11 @@ class DenseSaddlePoint {
 
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) { lu_.solve(rhs, solution); }
 
+  /// The weight of the geometric stiffness in A is not measured here (see
+  /// BlockSchurSaddlePoint::geometric_share): infinity, so an integrator that asked for it keeps
+  /// it.
+  double geometric_share() const { return std::numeric_limits<double>::infinity(); }
+
   /// Number of dependent rows of the last factorized matrix (0: full rank).
   int rank_deficiency() const { return rank_deficiency_; }
 
@@ -126,16 +131,26 @@ bool couples_bodies(const Model& model) {
   return coupled;
 }
 
-/// Inverse of a symmetric positive definite body block. Eigen inverts up to 4 x 4 in closed
-/// form; a 6 x 6 block goes through its 3 x 3 blocks, several times faster than a 6 x 6 LU.
+/// True if the symmetric 3 x 3 matrix a is positive definite (its leading minors).
+inline bool positive_definite(const Eigen::Matrix3d& a) {
+  return a(0, 0) > 0.0 && a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0) > 0.0 && a.determinant() > 0.0;
+}
+
+/// Inverse of a symmetric body block. Eigen inverts up to 4 x 4 in closed form; a 6 x 6 block
+/// goes through its 3 x 3 blocks, several times faster than a 6 x 6 LU. With `positive`, also
+/// says whether a is positive definite (for 6 x 6, whether both 3 x 3 pivots are).
 template <int N>
-Eigen::Matrix<double, N, N> invert_symmetric(const Eigen::Matrix<double, N, N>& a) {
+Eigen::Matrix<double, N, N> invert_symmetric(const Eigen::Matrix<double, N, N>& a,
+                                             bool* positive = nullptr) {
   if constexpr (N == 6) {
-    const Eigen::Matrix3d p_inverse = a.template topLeftCorner<3, 3>().inverse();
+    const Eigen::Matrix3d p = a.template topLeftCorner<3, 3>();
+    const Eigen::Matrix3d p_inverse = p.inverse();
     const Eigen::Matrix3d q = a.template topRightCorner<3, 3>();
     const Eigen::Matrix3d p_inverse_q = p_inverse * q;
-    const Eigen::Matrix3d schur_inverse =
-        (a.template bottomRightCorner<3, 3>() - q.transpose() * p_inverse_q).inverse();
+    const Eigen::Matrix3d schur =
+        a.template bottomRightCorner<3, 3>() - q.transpose() * p_inverse_q;
+    if (positive) *positive = positive_definite(p) && positive_definite(schur);
+    const Eigen::Matrix3d schur_inverse = schur.inverse();
     Eigen::Matrix<double, 6, 6> inverse;
     inverse.template topRightCorner<3, 3>() = -p_inverse_q * schur_inverse;
     inverse.template topLeftCorner<3, 3>() =
@@ -144,45 +159,13 @@ Eigen::Matrix<double, N, N> invert_symmetric(const Eigen::Matrix<double, N, N>& 
     inverse.template bottomRightCorner<3, 3>() = schur_inverse;
     return inverse;
   } else {
+    if (positive) {
+      if constexpr (N == 3)
+        *positive = positive_definite(a);
+      else
+        *positive = Eigen::LLT<Eigen::Matrix<double, N, N>>(a).info() == Eigen::Success;
+    }
     return a.inverse();
-  }
-}
-
-/// True if the symmetric 3 x 3 matrix a is positive definite (its leading minors).
-inline bool positive_definite(const Eigen::Matrix3d& a) {
-  return a(0, 0) > 0.0 && a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0) > 0.0 && a.determinant() > 0.0;
-}
-
-/// inverse = a^-1 if the symmetric a is positive definite; false (inverse unspecified) if not.
-/// The 6 x 6 case is invert_symmetric's, with its two 3 x 3 pivots checked on the way.
-template <int N>
-bool invert_positive_definite(const Eigen::Matrix<double, N, N>& a,
-                              Eigen::Matrix<double, N, N>& inverse) {
-  if constexpr (N == 6) {
-    const Eigen::Matrix3d p = a.template topLeftCorner<3, 3>();
-    if (!positive_definite(p)) return false;
-    const Eigen::Matrix3d p_inverse = p.inverse();
-    const Eigen::Matrix3d q = a.template topRightCorner<3, 3>();
-    const Eigen::Matrix3d p_inverse_q = p_inverse * q;
-    const Eigen::Matrix3d schur =
-        a.template bottomRightCorner<3, 3>() - q.transpose() * p_inverse_q;
-    if (!positive_definite(schur)) return false;
-    const Eigen::Matrix3d schur_inverse = schur.inverse();
-    inverse.template topRightCorner<3, 3>() = -p_inverse_q * schur_inverse;
-    inverse.template topLeftCorner<3, 3>() =
-        p_inverse - inverse.template topRightCorner<3, 3>() * p_inverse_q.transpose();
-    inverse.template bottomLeftCorner<3, 3>() = inverse.template topRightCorner<3, 3>().transpose();
-    inverse.template bottomRightCorner<3, 3>() = schur_inverse;
-    return true;
-  } else if constexpr (N == 3) {
-    if (!positive_definite(a)) return false;
-    inverse = a.inverse();
-    return true;
-  } else {
-    const Eigen::LLT<Eigen::Matrix<double, N, N>> cholesky(a);
-    if (cholesky.info() != Eigen::Success) return false;
-    inverse = cholesky.solve(Eigen::Matrix<double, N, N>::Identity());
-    return true;
   }
 }
 
@@ -577,7 +560,9 @@ class BlockSchurSaddlePoint {
       const Block symmetric = 0.5 * (blocks_[b] + blocks_[b].transpose());
       if (geometric) {
         const Block with_geometric = symmetric + 0.5 * (geometric_[b] + geometric_[b].transpose());
-        if (detail::invert_positive_definite<nv>(with_geometric, inverses_[b])) {
+        bool positive = false;
+        inverses_[b] = detail::invert_symmetric<nv>(with_geometric, &positive);
+        if (positive) {
           blocks_[b] += geometric_[b];
           geometric_share_ =
               std::max(geometric_share_,
