@@ -208,8 +208,8 @@ class BlockSchurSaddlePoint {
   /// Largest Newton contraction, estimated body by body as |A_b^-1 sum_j A_bj|, that the Schur
   /// complement of a large model may cost by leaving out the blocks by which force elements
   /// couple two bodies. Springs and dampers soft against mass over the step squared (the
-  /// scaling report's rope: 5e-5) keep the Schur path; stiffer ones take the whole matrix for
-  /// that factorization.
+  /// scaling report's rope: about 1e-3, mostly its dampers') keep the Schur path; stiffer ones
+  /// take the whole matrix for that factorization.
   static constexpr double max_dropped_coupling = 0.01;
 
   void analyze(const Model& model) {
