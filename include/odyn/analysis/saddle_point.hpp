@@ -213,6 +213,7 @@ class BlockSchurSaddlePoint {
   static constexpr double max_dropped_coupling = 0.01;
 
   void analyze(const Model& model) {
+    coupled_ = detail::couples_bodies(model);
     path_ = choose_path(model);
     whole_ = Whole::none;
     whole_dense_analyzed_ = whole_sparse_analyzed_ = false;
@@ -228,7 +229,6 @@ class BlockSchurSaddlePoint {
     n_ = model.num_velocities();
     m_ = model.num_equations();
     blocks_.assign(bodies_, Block::Zero());
-    coupled_ = detail::couples_bodies(model);
     if (coupled_) body_couplings_.assign(bodies_, Block::Zero());
     if (has_geometric_stiffness<Model>()) geometric_.assign(bodies_, Block::Zero());
     inverses_.assign(bodies_, Block::Zero());
@@ -432,21 +432,20 @@ class BlockSchurSaddlePoint {
   /// that join two moving bodies: small models take the whole matrix, large ones the Schur
   /// complement while the couplings weigh little; see max_dropped_coupling).
   Path choose_path(const Model& model) const {
-    const bool coupled = detail::couples_bodies(model);
     switch (choice_) {
       case LinearSolver::dense:
-        return coupled ? Path::dense_kkt : Path::dense_schur;
+        return coupled_ ? Path::dense_kkt : Path::dense_schur;
       case LinearSolver::klu:
         return Path::sparse_kkt;
       case LinearSolver::cholmod:
-        if (coupled)
+        if (coupled_)
           throw ModelError("linear_solver",
                            "cholmod factorizes the Schur complement B A^-1 B^T, which needs the "
                            "bodies uncoupled in A, but a force element here joins two moving "
                            "bodies; choose klu (or auto) for this model");
         return Path::sparse_schur;
       default:
-        if (coupled && model.num_velocities() + model.num_equations() <= dense_kkt_limit)
+        if (coupled_ && model.num_velocities() + model.num_equations() <= dense_kkt_limit)
           return Path::dense_kkt;
         return model.num_equations() <= dense_schur_limit ? Path::dense_schur : Path::sparse_schur;
     }
