@@ -101,10 +101,14 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
   for (const std::string name : {"dopri5", "dop853", "bdf"})
     if (known_integrator(name))
       for (double tol : tight) ladder.push_back({name, name, true, tol});
-  if (joint_coordinates)  // the same explicit methods on a spanning tree's joint coordinates
+  if (joint_coordinates) {  // the same explicit methods on a spanning tree's joint coordinates
     for (const std::string name : {"dopri5", "dop853"})
       for (double tol : tight)
         ladder.push_back({name + ", joint coordinates", name, true, tol, 0.9, 6, "joint"});
+    for (double h : steps)
+      ladder.push_back(
+          {"adams 6, fixed h, joint coordinates", "adams", false, 2.0 * h, 0.9, 6, "joint"});
+  }
   if (quick) {  // the ends of each family only
     std::vector<Setting> ends;
     for (std::size_t i = 0; i < ladder.size(); ++i)

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Work-precision report: builds bench/work_precision, runs every integrator over its ladder on the
-# engine and the hard cases, and plots error against CPU time.
-# Writes bench/results/work_precision.csv, bench/results/work_precision_<case>.png and the table
-# it prints to bench/results/work_precision.txt. Extra arguments go to the program
-# (for example --case engine --repeat 5).
+# engine and the hard cases, runs the peer engines (MuJoCo, Exudyn) on the engine with
+# bench/peer_engine.py, and plots error against CPU time, the peers on the engine's figure.
+# Writes bench/results/work_precision.csv, bench/results/peer_engine.csv,
+# bench/results/work_precision_<case>.png and the tables they print to
+# bench/results/work_precision.txt and bench/results/peer_engine.txt. Extra arguments go to
+# the C++ program (for example --case engine --repeat 5). See docs/work-precision.md.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -16,5 +18,13 @@ cmake --build build --target work_precision -j "$(nproc)"
 mkdir -p bench/results
 ./build/bench/work_precision --out bench/results/work_precision.csv "$@" |
   tee bench/results/work_precision.txt
+# The peers (about a minute; their packages live in build/peer-venv, created on first use). A
+# failure here leaves odyn's figures without the peers instead of stopping the report.
+peers=()
+if nice -n 10 python3 bench/peer_engine.py | tee bench/results/peer_engine.txt; then
+  peers=(--peers bench/results/peer_engine.csv)
+else
+  echo "bench/peer_engine.py failed: plotting odyn's runs only" >&2
+fi
 .venv/bin/python bench/plot_work_precision.py bench/results/work_precision.csv \
-  --out-dir bench/results
+  "${peers[@]}" --out-dir bench/results

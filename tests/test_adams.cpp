@@ -1,8 +1,8 @@
 // The fixed-step Adams-Bashforth integrator (index 1 + projection) against independent
 // references: a large-amplitude compound pendulum against its elliptic-integral solution (order
-// k on fixed steps), the engine in spatial and planar coordinates against the minimal-coordinate
-// reference (events, restarts, the constraint residuals), and a clear error beyond the
-// explicit stability limit.
+// k on fixed steps), the engine in spatial (absolute and joint) and planar coordinates against
+// the minimal-coordinate reference (events, restarts, the constraint residuals), and a clear
+// error beyond the explicit stability limit.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -71,12 +71,16 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
   for (const auto& sample : reference)
     peak_reaction = std::max(peak_reaction, std::abs(sample.R_z));
 
-  SECTION("spatial, order 5") {
+  // The same method in absolute and in joint coordinates (4 coordinates and the crank pin's 3
+  // closure equations instead of 18 and 17).
+  for (const char* coordinates : {"absolute", "joint"}) {
     auto e = engine::build();
     odyn::Workspace<engine::Model> ws(e.model);
     std::size_t k = 0;
     double z_error = 0.0, reaction_error = 0.0, velocity_residual = 0.0;
-    const auto summary = odyn::simulate(e.model, ws, adams(1e-4, 5), [&](const auto& state) {
+    auto settings = adams(1e-4, 5);
+    settings.coordinates = coordinates;
+    const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& state) {
       const auto& expected = reference.at(k++);
       z_error = std::max(z_error, std::abs(engine::piston_height(e, state) - expected.z_piston));
       // Away from the jumps of the gas force, where an output may sit on either side.
@@ -88,10 +92,12 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
           std::max(velocity_residual, odyn::constraint_residuals(e.model, state).second);
     });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
-    INFO("theta(1) error " << theta_error << ", z error " << z_error << ", R_z error "
-                           << reaction_error / peak_reaction << " of the peak, |Phi| "
-                           << summary.max_position_residual << ", |Phi_q v| " << velocity_residual);
-    // Generalized-alpha at this step: 5.1e-4 rad and 2.1e-5 m.
+    INFO(coordinates << " coordinates: theta(1) error " << theta_error << ", z error " << z_error
+                     << ", R_z error " << reaction_error / peak_reaction << " of the peak, |Phi| "
+                     << summary.max_position_residual << ", |Phi_q v| " << velocity_residual);
+    CHECK(k == reference.size());
+    // Generalized-alpha at this step: 5.1e-4 rad and 2.1e-5 m. Measured here: 8.6e-7 rad
+    // in absolute and 8.7e-7 rad in joint coordinates.
     CHECK(theta_error < 3e-6);
     CHECK(z_error < 1.5e-7);
     CHECK(reaction_error < 1e-5 * peak_reaction);

@@ -111,6 +111,28 @@ TEST_CASE("a dop853 step allocates nothing, in absolute and in joint coordinates
   check(std::type_identity<odyn::JointDormandPrince853<engine::Model>>{});
 }
 
+TEST_CASE("an Adams step allocates nothing, in absolute and in joint coordinates",
+          "[workspace][adams][joint]") {
+  const auto check = [](auto integrator_type) {
+    using Integrator = typename decltype(integrator_type)::type;
+    engine::Engine e = engine::build();
+    odyn::Workspace<engine::Model> ws(e.model);
+    odyn::assemble(e.model, ws);
+    Integrator integrator(e.model, ws, {.order = 5});
+    odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
+    allocations = 0;
+    counting = true;
+    // Through ignition: the restart's start-up steps (dopri5) run here too.
+    odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+    if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
+    counting = false;
+    CHECK(integrator.statistics().events >= 2);
+    CHECK(allocations == 0);
+  };
+  check(std::type_identity<odyn::AdamsBashforth<engine::Model>>{});
+  check(std::type_identity<odyn::JointAdamsBashforth<engine::Model>>{});
+}
+
 TEST_CASE("a dop853 step allocates nothing in joint coordinates' recursive passes",
           "[workspace][dop853][joint]") {
   // Ten ball-jointed links, the last tied back to the ground by a distance: 30 rates and one

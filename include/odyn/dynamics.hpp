@@ -34,9 +34,9 @@ struct DynamicsSettings {
   /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
   /// control), "adams" (fixed step, order adams.order).
   std::string integrator = "generalized-alpha";
-  /// What dopri5 and dop853 step: "absolute" (every body's position and orientation, every
-  /// joint a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that
-  /// close loops as constraints; spatial models; see analysis/joint_coordinates.hpp). The
+  /// What dopri5, dop853 and adams step: "absolute" (every body's position and orientation,
+  /// every joint a constraint) or "joint" (a spanning tree's joint coordinates, only the joints
+  /// that close loops as constraints; spatial models; see analysis/joint_coordinates.hpp). The
   /// other integrators step absolute coordinates.
   std::string coordinates = "absolute";
   /// The factorization of the linear systems, in the assembly and the integrator: "auto"
@@ -351,7 +351,8 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
       if (s.integrator == "dopri5") return simulate_with<JointDormandPrince>(model, ws, s, observe);
       if (s.integrator == "dop853")
         return simulate_with<JointDormandPrince853>(model, ws, s, observe);
-      throw ModelError("dynamics", "joint coordinates run with dopri5 or dop853, not '" +
+      if (s.integrator == "adams") return simulate_with<JointAdamsBashforth>(model, ws, s, observe);
+      throw ModelError("dynamics", "joint coordinates run with dopri5, dop853 or adams, not '" +
                                        s.integrator +
                                        "'; choose one of those, or coordinates "
                                        "'absolute' for this integrator");

@@ -303,7 +303,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     iteration of generalized-alpha and hht.
 
     coordinates: "absolute" (every body's position and orientation, every joint a constraint)
-    or, for spatial models with dopri5 or dop853, "joint": the bodies located through a
+    or, for spatial models with dopri5, dop853 or adams, "joint": the bodies located through a
     spanning tree of revolute, translational, cylindrical, universal, fixed and spherical
     joints, only the joints that close loops (distances, drivers, the rest) as constraints.
     Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive

@@ -96,6 +96,12 @@ class AbsoluteCoordinates {
     projection_.remove_normal_part(model_, ws_, solver_, error.tail(num_velocities()));
   }
 
+  /// max |Phi_q v + Phi_t| at the loaded state (constraints evaluated).
+  double velocity_residual() {
+    return num_equations() > 0 ? projection_.velocity_residual(model_, ws_).cwiseAbs().maxCoeff()
+                               : 0.0;
+  }
+
   /// Removes Phi_q v + Phi_t, least change in the mass metric.
   void correct_velocities() {
     projection_.velocity_residual(model_, ws_);

@@ -304,6 +304,13 @@ class JointCoordinates {
     remove_normal_part(error.tail(num_velocities()));
   }
 
+  /// max |C theta' + Phi_t| at the loaded state (constraints evaluated).
+  double velocity_residual() {
+    if (num_equations() == 0) return 0.0;
+    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);
+    return (closure_rhs_ + phi_t_).cwiseAbs().maxCoeff();
+  }
+
   /// Removes C theta' + Phi_t, least change in A.
   void correct_velocities() {
     closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);

@@ -28,13 +28,13 @@
 #include <cmath>
 #include <string>
 
-#include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/absolute_coordinates.hpp"
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/integrators/dormand_prince.hpp"
 #include "odyn/integrators/integrator.hpp"
-#include "odyn/linalg/all_finite.hpp"
 
 namespace odyn {
 
@@ -53,18 +53,15 @@ struct AdamsSettings {
   int max_projection_iterations = 6;
 };
 
-template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
-class AdamsBashforth {
+template <class Model, class Coordinates = AbsoluteCoordinates<Model>>
+class Adams {
  public:
   using Settings = AdamsSettings;
-  static constexpr int nv = Model::nv;
-  static constexpr int nq = Model::nq;
   static constexpr int kMaxOrder = 6;
 
   /// Starts from the workspace's consistent state (see assemble). `control` gives the
   /// tolerances that the reported error estimate is measured against.
-  AdamsBashforth(const Model& model, Workspace<Model>& ws, Settings settings = {},
-                 StepControl control = {})
+  Adams(const Model& model, Workspace<Model>& ws, Settings settings = {}, StepControl control = {})
       : model_(model),
         ws_(ws),
         settings_(settings),
@@ -73,7 +70,7 @@ class AdamsBashforth {
                  DormandPrinceSettings{settings.projection_tolerance,
                                        settings.max_projection_iterations, settings.linear_solver},
                  control),
-        projection_(model) {
+        coordinates_(starter_.coordinates()) {
     if (settings.order < 1 || settings.order > kMaxOrder)
       throw ModelError("adams", "the order must lie in [1, " + std::to_string(kMaxOrder) +
                                     "], got " + std::to_string(settings.order));
@@ -81,25 +78,24 @@ class AdamsBashforth {
       throw ModelError("adams", "the projection tolerances must be positive, got " +
                                     to_text(settings.projection_tolerance) + " and " +
                                     to_text(settings.velocity_tolerance));
-    nq_total_ = model.num_coordinates();
-    nv_total_ = model.num_velocities();
-    m_ = model.num_equations();
+    nq_total_ = coordinates_.num_positions();
+    nv_total_ = coordinates_.num_velocities();
+    m_ = coordinates_.num_equations();
     const Eigen::Index size = nq_total_ + nv_total_;
     y_n_ = Eigen::VectorXd::Zero(size);
     y_new_ = y_n_;
     estimate_ = y_n_;
+    loaded_ = y_n_;
     for (auto& f : history_) f = y_n_;
-    solver_.choose(settings.linear_solver);
-    solver_.analyze(model);
     initialize();
   }
 
   /// Takes the workspace's state as the committed one (v' and lambda solved afresh).
   void initialize() {
     t_n_ = ws_.t;
-    y_n_ << ws_.q, ws_.v;
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    coordinates_.read_state(y_n_);
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     restart();
   }
 
@@ -108,8 +104,8 @@ class AdamsBashforth {
   void restart() {
     rollback();
     starter_.initialize();
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     known_ = 0;
     push_derivative();
     ++statistics_.restarts;
@@ -148,10 +144,10 @@ class AdamsBashforth {
       advance_states(model_, ws_);
     }
     t_n_ = ws_.t;
-    y_n_ << ws_.q, ws_.v;
+    coordinates_.read_state(y_n_);
     flush_subnormal(y_n_);
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     step_sizes_[(known_ - 1) % kHistory] = h_;
     push_derivative();
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
@@ -160,15 +156,16 @@ class AdamsBashforth {
 
   /// Puts the workspace back at the last committed state, its blocks and forces evaluated.
   void rollback() {
-    ws_.t = t_n_;
-    ws_.q = y_n_.head(nq_total_);
-    ws_.v = y_n_.tail(nv_total_);
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
+    coordinates_.load(t_n_, y_n_);
+    coordinates_.restore_solution(vdot_n_, lambda_n_);
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
   }
+
+  /// The workspace's blocks, v' and lambda for every element at the loaded state, when the
+  /// coordinates keep only some of them up to date while stepping (joint coordinates).
+  void refresh_blocks() requires requires(Coordinates& c) { c.complete_workspace(); }
+  { coordinates_.complete_workspace(); }
 
   /// Rolls back and throws the SolverError that explains the last failed attempt.
   [[noreturn]] void fail() {
@@ -213,10 +210,9 @@ class AdamsBashforth {
   /// f at the workspace's state (v' solved there) becomes f_n.
   void push_derivative() {
     Eigen::VectorXd& f = history_[known_ % kHistory];
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      f.template segment<nq>(b * nq) = Model::Space::configuration_rate(
-          ws_.q.template segment<nq>(b * nq), ws_.v.template segment<nv>(b * nv));
-    f.tail(nv_total_) = ws_.vdot;
+    coordinates_.read_state(loaded_);
+    coordinates_.position_rate(loaded_, f.head(nq_total_));
+    f.tail(nv_total_) = coordinates_.accelerations();
     flush_subnormal(f);
     ++known_;
   }
@@ -284,45 +280,38 @@ class AdamsBashforth {
   /// the mass metric) where it has drifted beyond the tolerances, with v' and lambda solved
   /// there. One factorization, at the predicted positions, unless the positions moved.
   bool project(double t, const Eigen::VectorXd& y) {
-    ws_.t = t;
-    ws_.q = y.head(nq_total_);
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = y.tail(nv_total_);
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.load(t, y);
+    coordinates_.evaluate_constraints();
     if (!factorize()) return false;
     bool moved = false;
-    for (int k = 0; m_ > 0 && !(ws_.phi.cwiseAbs().maxCoeff() <= settings_.projection_tolerance);
+    for (int k = 0; m_ > 0 && !(coordinates_.position_residual() <= settings_.projection_tolerance);
          ++k) {
       if (k == settings_.max_projection_iterations) return false;
-      projection_.correct_positions(model_, ws_, solver_);
+      coordinates_.correct_positions();
       ++statistics_.newton_iterations;
       moved = true;
     }
     // v' and lambda feed the history: solved with the matrix at the final positions.
     if (moved && !factorize()) return false;
-    if (m_ > 0 && !(projection_.velocity_residual(model_, ws_).cwiseAbs().maxCoeff() <=
-                    settings_.velocity_tolerance)) {
-      projection_.correct_velocities(model_, ws_, solver_);
+    if (m_ > 0 && !(coordinates_.velocity_residual() <= settings_.velocity_tolerance)) {
+      coordinates_.correct_velocities();
       ++statistics_.newton_iterations;
     }
-    return projection_.solve_accelerations(model_, ws_, solver_) && all_finite(ws_.q) &&
-           all_finite(ws_.v);
+    return coordinates_.solve_accelerations() && coordinates_.state_finite();
   }
 
   bool factorize() {
     ++statistics_.factorizations;
-    return solver_.factorize(model_, ws_, IterationFactors{});
+    return coordinates_.factorize();
   }
 
   const Model& model_;
   Workspace<Model>& ws_;
   Settings settings_;
   StepControl control_;
-  DormandPrince<Model, Solver> starter_;
-  Solver solver_;
-  ConstraintProjection<Model> projection_;
+  // The start-up method; it owns the coordinates, which this class steps too.
+  ExplicitRungeKutta<DormandPrince5Tableau, Model, Coordinates> starter_;
+  Coordinates& coordinates_;
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0;
   double t_n_ = 0.0, h_ = 0.0, error_ = 0.0;
@@ -333,6 +322,15 @@ class AdamsBashforth {
   std::array<double, kMaxOrder + 1> weights_{}, error_weights_{};
   int estimate_points_ = 0;  // derivatives the cached estimate weights use; 0: none cached
   Eigen::VectorXd y_n_, y_new_, estimate_, vdot_n_, lambda_n_;
+  Eigen::VectorXd loaded_;  // the coordinates' loaded state, read back
 };
+
+/// Adams-Bashforth on the bodies' own coordinates (every joint a constraint).
+template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
+using AdamsBashforth = Adams<Model, AbsoluteCoordinates<Model, Solver>>;
+
+/// The same method on joint coordinates (see analysis/joint_coordinates.hpp).
+template <class Model>
+using JointAdamsBashforth = Adams<Model, JointCoordinates<Model>>;
 
 }  // namespace odyn

@@ -260,6 +260,9 @@ class ExplicitRungeKutta {
   void count_event() { ++statistics_.events; }
   const IntegratorStatistics& statistics() const { return statistics_; }
   const Settings& settings() const { return settings_; }
+  /// The coordinates it steps, with the workspace's state loaded (a multistep method started
+  /// by this one steps the same object).
+  Coordinates& coordinates() { return coordinates_; }
 
  private:
   static constexpr int s = Method::stages;
