@@ -4,7 +4,8 @@
 # bench/peer_engine.py, and plots error against CPU time, the peers on the engine's figure.
 # Writes bench/results/work_precision.csv, bench/results/peer_engine.csv,
 # bench/results/work_precision_<case>.png and the tables they print to
-# bench/results/work_precision.txt and bench/results/peer_engine.txt. Extra arguments go to
+# bench/results/work_precision.txt and bench/results/peer_engine.txt, and the peers next to odyn
+# (bench/compare_work_precision.py) to bench/results/peer_comparison.md. Extra arguments go to
 # the C++ program (for example --case engine --repeat 5). See docs/work-precision.md.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -23,6 +24,9 @@ mkdir -p bench/results
 peers=()
 if nice -n 10 python3 bench/peer_engine.py | tee bench/results/peer_engine.txt; then
   peers=(--peers bench/results/peer_engine.csv)
+  # Each peer run next to odyn's cheapest run at least as accurate (docs/work-precision.md).
+  nice -n 10 python3 bench/compare_work_precision.py bench/results/work_precision.csv \
+    bench/results/peer_engine.csv --out bench/results/peer_comparison.md
 else
   echo "bench/peer_engine.py failed: plotting odyn's runs only" >&2
 fi

@@ -138,22 +138,36 @@ void end_step_on_switch(
 
 }  // namespace detail
 
+/// How far a fixed step is cut after failed attempts (see advance_to); kept from one call to the
+/// next, so that a run does not try the full step again right after it failed.
+struct StepCut {
+  static constexpr int max_halvings = 4;  // down to 1/16 of the fixed step
+  int halvings = 0;
+  int good_steps = 0;  // since the last change
+  int needed = 1;      // good steps before the step doubles again; grows while failures recur
+};
+
 /// Advances an integrator to `t_target`, landing on it exactly. A fixed-step integrator takes
-/// equal steps no longer than `fixed_step`; an adaptive one takes the steps its error control
-/// proposes (never longer than `max_step`), and a rejected step is tried again shorter. A step in
-/// which an element's event function crosses zero is cut back to end on the switch, then the
-/// integrator restarts.
+/// equal steps no longer than `fixed_step`; where one fails to converge (RetriesShorterSteps),
+/// it is tried again at half the size, down to 1/16, and the size doubles back after a few good
+/// steps (`cut` keeps that state across calls; the run stops when the smallest step fails too). An
+/// adaptive integrator takes the steps its error control proposes (never longer than `max_step`),
+/// and a rejected step is tried again shorter. A step in which an element's event function crosses
+/// zero is cut back to end on the switch, then the integrator restarts.
 template <class Model, StepIntegrator Integrator>
 void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator, double t_target,
-                double fixed_step, double event_time_tolerance = 1e-12) {
+                double fixed_step, double event_time_tolerance = 1e-12, StepCut* cut = nullptr) {
   constexpr bool can_adapt = AdaptiveIntegrator<Integrator>;
   const bool adaptive = can_adapt && integrator.adaptive();
+  StepCut local_cut;
+  StepCut& step_cut = cut ? *cut : local_cut;
   while (integrator.time() < t_target - 1e-12 * std::max(1.0, std::abs(t_target))) {
     const double remaining = t_target - integrator.time();
     double h = 0.0;
     if constexpr (can_adapt) h = integrator.proposed_step();
     if (!adaptive) {
-      const double steps = std::ceil(remaining / fixed_step - 1e-9);
+      const double step = std::ldexp(fixed_step, -step_cut.halvings);
+      const double steps = std::ceil(remaining / step - 1e-9);
       h = remaining / std::max(1.0, steps);
     } else if (h >= remaining) {
       h = remaining;
@@ -169,7 +183,23 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
         continue;
       }
     }
-    if (!computed) integrator.fail();
+    if (!computed) {
+      if (RetriesShorterSteps<Integrator> && step_cut.halvings < StepCut::max_halvings) {
+        integrator.rollback();
+        ++step_cut.halvings;
+        step_cut.good_steps = 0;
+        step_cut.needed = std::min(64, 2 * step_cut.needed);
+        continue;
+      }
+      if (step_cut.halvings == 0) integrator.fail();
+      try {
+        integrator.fail();
+      } catch (const SolverError& error) {
+        throw SolverError(error.time(), error.message() + " (The fixed step had been cut to 1/" +
+                                            std::to_string(1 << step_cut.halvings) +
+                                            " of its size there and still failed.)");
+      }
+    }
     if constexpr (has_events<Model>()) {
       const double g_end = event_function(model, ws);
       if (g_end >= 0.0 && g_start < 0.0) {
@@ -184,6 +214,11 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
       }
     }
     integrator.commit();
+    if (step_cut.halvings > 0 && ++step_cut.good_steps >= step_cut.needed) {
+      --step_cut.halvings;
+      step_cut.good_steps = 0;
+      step_cut.needed = std::max(2, step_cut.needed / 2);
+    }
   }
 }
 
@@ -332,8 +367,10 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   if constexpr (DenseOutputIntegrator<Integrator>) dense = integrator.adaptive();
   if constexpr (DenseOutputIntegrator<Integrator>)
     if (dense) advance_with_dense_output(model, ws, integrator, s.output_interval, outputs, record);
+  StepCut cut;
   for (long k = 1; k <= outputs && !dense; ++k) {
-    advance_to(model, ws, integrator, t0 + static_cast<double>(k) * s.output_interval, s.step);
+    advance_to(model, ws, integrator, t0 + static_cast<double>(k) * s.output_interval, s.step,
+               1e-12, &cut);
     record();
   }
   summary.statistics = integrator.statistics();

@@ -292,7 +292,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
-    rho_inf) or "hht" take fixed steps of at most `step`, or, with error control (`adaptive`;
+    rho_inf) or "hht" take fixed steps of at most `step` (a step whose Newton iteration fails
+    is tried again in halves, down to step / 16, and grows back after a few good steps), or,
+    with error control (`adaptive`;
     on by default when rtol or atol is given), steps from the local error estimate starting at
     `step`; "dopri5" and "dop853" (explicit Dormand-Prince 5(4) and 8(5,3), positions projected
     onto the constraints to `projection_tolerance`) and "bdf" always control their error;

@@ -40,8 +40,10 @@ class AssemblyError : public Error {
 class SolverError : public Error {
  public:
   SolverError(double time, const std::string& message)
-      : Error(describe(time, message)), time_(time) {}
+      : Error(describe(time, message)), time_(time), message_(message) {}
   double time() const { return time_; }
+  /// What failed, without the time.
+  const std::string& message() const { return message_; }
 
  private:
   static std::string describe(double time, const std::string& message) {
@@ -50,6 +52,7 @@ class SolverError : public Error {
     return text.str();
   }
   double time_;
+  std::string message_;
 };
 
 /// Formats a value for an error message with enough digits to be useful.

@@ -55,6 +55,7 @@ template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
 class GeneralizedAlpha {
  public:
   using Settings = GeneralizedAlphaSettings;
+  static constexpr bool retries_shorter_steps = true;  // a failure is Newton's (see attempt)
   static constexpr int nv = Model::nv;
   static constexpr int nq = Model::nq;
 

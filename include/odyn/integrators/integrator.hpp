@@ -88,6 +88,12 @@ concept StepIntegrator = requires(I& i, const I& ci, double h) {
   { ci.statistics() } -> std::convertible_to<IntegratorStatistics>;
 };
 
+/// An integrator whose failed fixed step is a Newton iteration that did not converge: the
+/// committed state is sound and a shorter step may pass (see advance_to). An explicit method's
+/// failure follows an instability that has already spoiled the state, so it stops instead.
+template <class I>
+concept RetriesShorterSteps = StepIntegrator<I> && I::retries_shorter_steps;
+
 /// An integrator with error control.
 template <class I>
 concept AdaptiveIntegrator = StepIntegrator<I> && requires(I& i, const I& ci) {
