@@ -105,10 +105,15 @@ def plot(case: str, families: dict[str, list[tuple[float, float, float]]], out: 
         first = ax.legend(*own, fontsize=8, title="odyn", title_fontsize=8,
                           loc="upper left", bbox_to_anchor=(1.01, 1.0))
         ax.add_artist(first)
-        ax.legend(handles=peer_lines, fontsize=8, title="peers (Python force callbacks)",
-                  title_fontsize=8, loc="lower left", bbox_to_anchor=(1.01, 0.0))
-    else:
-        ax.legend(fontsize=8)
+        second = ax.legend(handles=peer_lines, fontsize=8,
+                           title="peers (Python force callbacks)", title_fontsize=8,
+                           loc="lower left", bbox_to_anchor=(1.01, 0.0))
+        # tight_layout leaves legends outside the axes out: the saved box takes them in.
+        fig.tight_layout()
+        fig.savefig(out, dpi=110, bbox_inches="tight", bbox_extra_artists=[first, second])
+        plt.close(fig)
+        return
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
