@@ -64,13 +64,12 @@ import csv
 import math
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from peer_scaling import PACKAGES, VENV, VENV_PYTHON, in_venv  # noqa: E402
+from peer_scaling import PACKAGES, ensure_venv_and_reexec, in_venv  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_CSV = REPO / "bench" / "results" / "peer_engine.csv"
@@ -728,26 +727,12 @@ def print_table(rows):
               f"{fmt(r['max_phi'], '.1e')} | {r['newton_iterations']} | {r['status']} |")
 
 
-def ensure_venv_and_reexec(argv):
-    """As bench/peer_scaling.py: create build/peer-venv if missing, pip-install what is not
-    importable (the versions pinned there), re-execute this script inside it."""
-    if not VENV_PYTHON.exists():
-        base = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable
-        print(f"creating {VENV} with {base} -m venv", flush=True)
-        subprocess.run([base, "-m", "venv", str(VENV)], check=True)
-    probe = ("import importlib.util, sys\n"
-             "print(' '.join(m for m in sys.argv[1:] if importlib.util.find_spec(m) is None))")
-    wanted = {dist: PACKAGES[dist] for dist in NEEDED}
-    out = subprocess.run([str(VENV_PYTHON), "-c", probe, *(mod for mod, _ in wanted.values())],
-                         check=True, capture_output=True, text=True).stdout.split()
-    missing = [f"{dist}=={ver}" for dist, (mod, ver) in wanted.items() if mod in out]
-    if missing:
-        print("pip install " + " ".join(missing), flush=True)
-        subprocess.run([str(VENV_PYTHON), "-m", "pip", "install", "--quiet", *missing],
-                       check=True)
-    sys.stdout.flush()
+def reexec_in_venv(argv):
+    """bench/peer_scaling.py's scratch environment with the packages this script imports, one
+    thread per numerical library."""
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
-    os.execve(str(VENV_PYTHON), [str(VENV_PYTHON), str(Path(__file__).resolve()), *argv], env)
+    ensure_venv_and_reexec(argv, script=__file__,
+                           packages={dist: PACKAGES[dist] for dist in NEEDED}, env=env)
 
 
 def parse_args(argv):
@@ -771,7 +756,7 @@ def main(argv):
         if e not in ("mujoco", "exudyn"):
             sys.exit(f"unknown engine {e!r}; choose from mujoco, exudyn")
     if not in_venv():
-        ensure_venv_and_reexec(argv)
+        reexec_in_venv(argv)
     import warnings
     warnings.simplefilter("ignore", DeprecationWarning)
     import exudyn

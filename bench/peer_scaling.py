@@ -100,24 +100,29 @@ def in_venv():
     return Path(sys.prefix).resolve() == VENV.resolve()
 
 
-def ensure_venv_and_reexec(argv):
-    """Create build/peer-venv if missing, pip-install what is not importable, re-exec in it."""
+def ensure_venv_and_reexec(argv, script=None, packages=None, env=None):
+    """Create build/peer-venv if missing, pip-install what is not importable (of `packages`,
+    a subset of PACKAGES; all by default), re-exec `script` (this file by default) in it, with
+    the environment `env` (this process's by default)."""
+    packages = PACKAGES if packages is None else packages
     if not VENV_PYTHON.exists():
         base = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable
         print(f"creating {VENV} with {base} -m venv", flush=True)
         subprocess.run([base, "-m", "venv", str(VENV)], check=True)
     probe = ("import importlib.util, sys\n"
              "print(' '.join(m for m in sys.argv[1:] if importlib.util.find_spec(m) is None))")
-    modules = [mod for mod, _ in PACKAGES.values()]
+    modules = [mod for mod, _ in packages.values()]
     out = subprocess.run([str(VENV_PYTHON), "-c", probe, *modules],
                          check=True, capture_output=True, text=True).stdout.split()
-    missing = [f"{dist}=={ver}" for dist, (mod, ver) in PACKAGES.items() if mod in out]
+    missing = [f"{dist}=={ver}" for dist, (mod, ver) in packages.items() if mod in out]
     if missing:
         print("pip install " + " ".join(missing), flush=True)
         subprocess.run([str(VENV_PYTHON), "-m", "pip", "install", "--quiet", *missing],
                        check=True)
     sys.stdout.flush()
-    os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), str(Path(__file__).resolve()), *argv])
+    script = Path(script or __file__).resolve()
+    os.execve(str(VENV_PYTHON), [str(VENV_PYTHON), str(script), *argv],
+              os.environ if env is None else env)
 
 
 # =========================================================================================

@@ -7,7 +7,6 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <new>
-#include <type_traits>
 #include <vector>
 
 #include "engine_model.hpp"
@@ -90,47 +89,36 @@ TEST_CASE("a BDF step allocates nothing, events and restarts included", "[worksp
   CHECK(allocations == 0);
 }
 
+/// The engine from 5 ms to 50 ms, through ignition (an event and a restart), counting the
+/// allocations after a warm-up.
+template <class Integrator>
+void check_engine_run(const typename Integrator::Settings& settings, odyn::StepControl control) {
+  engine::Engine e = engine::build();
+  odyn::Workspace<engine::Model> ws(e.model);
+  odyn::assemble(e.model, ws);
+  Integrator integrator(e.model, ws, settings, control);
+  odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
+  allocations = 0;
+  counting = true;
+  odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
+  if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
+  counting = false;
+  CHECK(integrator.statistics().events >= 2);
+  CHECK(allocations == 0);
+}
+
 TEST_CASE("a dop853 step allocates nothing, in absolute and in joint coordinates",
           "[workspace][dop853][joint]") {
-  const auto check = [](auto integrator_type) {
-    using Integrator = typename decltype(integrator_type)::type;
-    engine::Engine e = engine::build();
-    odyn::Workspace<engine::Model> ws(e.model);
-    odyn::assemble(e.model, ws);
-    Integrator integrator(e.model, ws, {}, {.rtol = 1e-8, .atol = 1e-8, .first_step = 1e-5});
-    odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
-    allocations = 0;
-    counting = true;
-    odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
-    if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
-    counting = false;
-    CHECK(integrator.statistics().events >= 2);
-    CHECK(allocations == 0);
-  };
-  check(std::type_identity<odyn::DormandPrince853<engine::Model>>{});
-  check(std::type_identity<odyn::JointDormandPrince853<engine::Model>>{});
+  const odyn::StepControl control{.rtol = 1e-8, .atol = 1e-8, .first_step = 1e-5};
+  check_engine_run<odyn::DormandPrince853<engine::Model>>({}, control);
+  check_engine_run<odyn::JointDormandPrince853<engine::Model>>({}, control);
 }
 
 TEST_CASE("an Adams step allocates nothing, in absolute and in joint coordinates",
           "[workspace][adams][joint]") {
-  const auto check = [](auto integrator_type) {
-    using Integrator = typename decltype(integrator_type)::type;
-    engine::Engine e = engine::build();
-    odyn::Workspace<engine::Model> ws(e.model);
-    odyn::assemble(e.model, ws);
-    Integrator integrator(e.model, ws, {.order = 5});
-    odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
-    allocations = 0;
-    counting = true;
-    // Through ignition: the restart's start-up steps (dopri5) run here too.
-    odyn::advance_to(e.model, ws, integrator, 0.05, 1e-4);
-    if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
-    counting = false;
-    CHECK(integrator.statistics().events >= 2);
-    CHECK(allocations == 0);
-  };
-  check(std::type_identity<odyn::AdamsBashforth<engine::Model>>{});
-  check(std::type_identity<odyn::JointAdamsBashforth<engine::Model>>{});
+  // The restart at ignition runs the start-up steps (dopri5) too.
+  check_engine_run<odyn::AdamsBashforth<engine::Model>>({.order = 5}, {});
+  check_engine_run<odyn::JointAdamsBashforth<engine::Model>>({.order = 5}, {});
 }
 
 TEST_CASE("a dop853 step allocates nothing in joint coordinates' recursive passes",
