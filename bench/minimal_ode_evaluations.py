@@ -11,44 +11,14 @@ work-precision section).
     python bench/minimal_ode_evaluations.py     # needs numpy and scipy (pip install scipy)
 """
 
+import sys
+from pathlib import Path
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
-# shared/specs/engine.md
-R, L, D, C = 0.04, 0.14, 0.08, 9.0
-P_ATM, KAPPA, P_COMB = 101325.0, 1.4, 3.0e6
-C_LOAD, G = 0.1, 9.81
-M_ROD, M_PISTON, I_CRANK, I_ROD = 0.253, 0.643, 1.524, 0.399
-OMEGA0 = 157.08
-AREA = np.pi * D * D / 4
-V_C = AREA * 2 * R / (C - 1)
-V_1 = V_C + 2 * R * AREA
-
-
-def angular_acceleration(stroke, theta, omega):
-    """Lagrange's equation in theta, as in the C++ reference."""
-    s, c = np.sin(theta), np.cos(theta)
-    w = np.sqrt(L * L - R * R * s * s)
-    dw = -R * R * s * c / w
-    ddw = -(R * R * (c * c - s * s) + dw * dw) / w
-    z_piston, dz_piston, ddz_piston = R * c + w, -R * s + dw, -R * c + ddw
-    dz_rod, ddz_rod = -R * s + 0.5 * dw, -R * c + 0.5 * ddw
-    dy_rod, ddy_rod = -0.5 * R * c, 0.5 * R * s
-    dphi_rod = -R * c / w
-    ddphi_rod = R * s / w + R * c * dw / (w * w)
-    inertia = (I_CRANK + M_ROD * (dy_rod**2 + dz_rod**2) + I_ROD * dphi_rod**2
-               + M_PISTON * dz_piston**2)
-    inertia_rate = 2 * (M_ROD * (dy_rod * ddy_rod + dz_rod * ddz_rod) + I_ROD * dphi_rod * ddphi_rod
-                        + M_PISTON * dz_piston * ddz_piston)
-    volume = V_C + AREA * ((R + L) - z_piston)
-    pressure = P_ATM
-    if stroke == 1:
-        pressure = P_ATM * (V_1 / volume) ** KAPPA
-    elif stroke == 2:
-        pressure = (P_ATM * C**KAPPA + P_COMB) * (V_C / volume) ** KAPPA
-    gas = -(pressure - P_ATM) * AREA
-    force = gas * dz_piston - C_LOAD * omega - G * (M_ROD * dz_rod + M_PISTON * dz_piston)
-    return (force - 0.5 * inertia_rate * omega * omega) / inertia
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from engine_equation import OMEGA0, angular_acceleration  # noqa: E402
 
 
 def theta_at_one_second(method, tol):

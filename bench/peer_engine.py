@@ -69,6 +69,9 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from engine_equation import (C_LOAD, G, I_CRANK, I_PISTON, I_ROD, L, M_CRANK,  # noqa: E402
+                             M_PISTON, M_ROD, OMEGA0, R, angular_acceleration, gas_force,
+                             piston_height)
 from peer_scaling import PACKAGES, ensure_venv_and_reexec, in_venv  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
@@ -96,62 +99,9 @@ N_OUT = round(T_END / DT_OUT)
 # The model (shared/specs/engine.md) and its reference solution
 # =========================================================================================
 
-R, L, D, C = 0.04, 0.14, 0.08, 9.0
-P_ATM, KAPPA, P_COMB = 101325.0, 1.4, 3.0e6
-C_LOAD, G = 0.1, 9.81
-M_CRANK, M_ROD, M_PISTON = 1.399, 0.253, 0.643
-I_CRANK, I_ROD, I_PISTON = (1.524, 1.291, 0.836), (0.399, 0.372, 0.0349), (0.457, 0.506, 0.653)
-OMEGA0 = 157.08
-AREA = math.pi * D * D / 4
-V_C = AREA * 2 * R / (C - 1)
-V_1 = V_C + 2 * R * AREA
-P_POWER = P_ATM * C**KAPPA + P_COMB
-
 # theta(1) of tests/reference/engine_reference.hpp (RK4, h = 1e-5), as printed by the C++ code
 # to 12 decimals (bench/minimal_ode_evaluations.py quotes it); the port must agree.
 THETA1_CPP = 158.286033924795
-
-
-def stroke_of(theta):
-    """0 intake, 1 compression, 2 power, 3 exhaust: floor(theta / pi) mod 4."""
-    return int(theta // math.pi) % 4
-
-
-def gas_force(stroke, z_piston):
-    """Gas force on the piston along +Z in the given stroke (engine.md, Forces 2)."""
-    if stroke == 1:
-        volume = V_C + AREA * ((R + L) - z_piston)
-        return -(P_ATM * (V_1 / volume) ** KAPPA - P_ATM) * AREA
-    if stroke == 2:
-        volume = V_C + AREA * ((R + L) - z_piston)
-        return -(P_POWER * (V_C / volume) ** KAPPA - P_ATM) * AREA
-    return 0.0
-
-
-def piston_height(theta):
-    """z of the piston for crank angle theta, from the loop's kinematics."""
-    s = math.sin(theta)
-    return R * math.cos(theta) + math.sqrt(L * L - R * R * s * s)
-
-
-def angular_acceleration(stroke, theta, omega):
-    """Lagrange's equation in theta: J alpha + J' omega^2 / 2 = Q (engine_reference.hpp)."""
-    s, c = math.sin(theta), math.cos(theta)
-    w = math.sqrt(L * L - R * R * s * s)
-    dw = -R * R * s * c / w
-    ddw = -(R * R * (c * c - s * s) + dw * dw) / w
-    z_piston, dz_piston, ddz_piston = R * c + w, -R * s + dw, -R * c + ddw
-    dz_rod, ddz_rod = -R * s + 0.5 * dw, -R * c + 0.5 * ddw
-    dy_rod, ddy_rod = -0.5 * R * c, 0.5 * R * s
-    dphi_rod = -R * c / w
-    ddphi_rod = R * s / w + R * c * dw / (w * w)
-    inertia = (I_CRANK[0] + M_ROD * (dy_rod * dy_rod + dz_rod * dz_rod)
-               + I_ROD[0] * dphi_rod * dphi_rod + M_PISTON * dz_piston * dz_piston)
-    inertia_rate = 2 * (M_ROD * (dy_rod * ddy_rod + dz_rod * ddz_rod)
-                        + I_ROD[0] * dphi_rod * ddphi_rod + M_PISTON * dz_piston * ddz_piston)
-    force = (gas_force(stroke, z_piston) * dz_piston - C_LOAD * omega
-             - G * (M_ROD * dz_rod + M_PISTON * dz_piston))
-    return (force - 0.5 * inertia_rate * omega * omega) / inertia
 
 
 def _rk4_increment(theta, omega, h, stroke):
