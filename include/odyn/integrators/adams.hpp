@@ -89,6 +89,9 @@ class Adams {
     for (auto& f : history_) f = y_n_;
     initialize();
   }
+  // coordinates_ refers into starter_: a copy would step the original's coordinates.
+  Adams(const Adams&) = delete;
+  Adams& operator=(const Adams&) = delete;
 
   /// Takes the workspace's state as the committed one (v' and lambda solved afresh).
   void initialize() {
