@@ -22,7 +22,8 @@
 // N = 256: its N / 3 loops make each evaluation O(N^2)). There step_s is one forward-dynamics
 // evaluation, what each stage of dopri5 or dop853 costs (the frames down the tree, the
 // closures, the articulated-body factorization and solve), and setup_s the assembly plus the
-// tree's construction.
+// tree's construction. spherical-chain-joint-alpha and spherical-chain-moving-joint-alpha step
+// the two chains with generalized-alpha in joint coordinates (step_s a step, as above).
 // setup_s: assembly (positions, the given velocities, accelerations) plus the integrator's
 // analysis, wall time. step_s: the median over 5 blocks of steps of the wall time per step
 // (per h of simulated time where a step that failed to converge was cut, as in simulate()).
@@ -193,6 +194,9 @@ double median_time(Work&& work, long& calls) {
   return per_call[per_call.size() / 2];
 }
 
+/// The model with generalized-alpha at h = step (absolute coordinates, or joint coordinates
+/// with JointGeneralizedAlpha): setup (assembly and the integrator) and the time per step.
+template <class Integrator = odyn::GeneralizedAlpha<Model>>
 Row measure(const std::string& name, const Model& model) {
   Row row;
   row.name = name;
@@ -203,7 +207,7 @@ Row measure(const std::string& name, const Model& model) {
     const auto start = Clock::now();
     odyn::assemble(model, ws);
     row.assembly_s = seconds_since(start);
-    odyn::GeneralizedAlpha<Model> integrator(model, ws);
+    Integrator integrator(model, ws);
     row.setup_s = seconds_since(start);
     // As simulate() steps: a step that fails to converge is cut (advance_to), so step_s is
     // the time per h of simulated time.
@@ -214,6 +218,7 @@ Row measure(const std::string& name, const Model& model) {
         },
         row.steps);
     newton_per_step_of(row, integrator.statistics());
+    integrator.refresh_blocks();  // in joint coordinates, fills in the workspace's q
     if (!ws.q.allFinite()) row.status = "non-finite state";
   } catch (const std::exception& e) {
     row.status = std::string("failed: ") + e.what();
@@ -292,6 +297,9 @@ int main(int argc, char** argv) {
       {"revolute-chain-joint", [](int n) { return chain(n, Joint::hinge, false); }},
       {"binary-tree-joint", [](int n) { return binary_tree(n); }},
       {"four-bar-ladder-joint", [](int n) { return four_bar_ladder(n); }},
+      {"spherical-chain-joint-alpha", [](int n) { return chain(n, Joint::ball, false); }},
+      {"spherical-chain-moving-joint-alpha",
+       [](int n) { return chain(n, Joint::ball, false, true); }},
   };
   std::ofstream csv(out);
   csv << "case,N,equations,setup_s,assembly_s,step_s,steps,newton_per_step,"
@@ -306,7 +314,10 @@ int main(int argc, char** argv) {
       const bool joint = name.ends_with("-joint");
       if (ladder && (n < 3 || (joint && n > 256))) continue;
       const Model model = build(ladder ? 3 * std::max(1, n / 3) : n);
-      const Row row = joint ? measure_joint(name, model) : measure(name, model);
+      const Row row = joint ? measure_joint(name, model)
+                      : name.ends_with("-alpha")
+                          ? measure<odyn::JointGeneralizedAlpha<Model>>(name, model)
+                          : measure(name, model);
       csv << row.name << ',' << row.bodies << ',' << row.equations << ',' << row.setup_s << ','
           << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.newton_per_step
           << ',' << row.factorizations_per_step << ',' << row.peak_rss_mb << ',' << row.status

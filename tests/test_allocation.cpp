@@ -121,8 +121,14 @@ TEST_CASE("an Adams step allocates nothing, in absolute and in joint coordinates
   check_engine_run<odyn::JointAdamsBashforth<engine::Model>>({.order = 5}, {});
 }
 
-TEST_CASE("a dop853 step allocates nothing in joint coordinates' recursive passes",
-          "[workspace][dop853][joint]") {
+TEST_CASE("a generalized-alpha step allocates nothing in joint coordinates", "[workspace][joint]") {
+  check_engine_run<odyn::JointGeneralizedAlpha<engine::Model>>({}, {});
+}
+
+TEST_CASE(
+    "dop853 and generalized-alpha steps allocate nothing in joint coordinates' recursive "
+    "passes",
+    "[workspace][dop853][joint]") {
   // Ten ball-jointed links, the last tied back to the ground by a distance: 30 rates and one
   // closure, above the size at which the whole saddle-point matrix is formed.
   namespace sp = odyn::spatial;
@@ -142,17 +148,21 @@ TEST_CASE("a dop853 step allocates nothing in joint coordinates' recursive passe
   }
   model.add(sp::Distance("tie", previous, {0.5, 0.0, 0.0}, odyn::ground, {11.0, 0.0, -1.0}));
   model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
-  odyn::Workspace<Model> ws(model);
-  odyn::assemble(model, ws);
-  odyn::JointDormandPrince853<Model> integrator(model, ws, {}, {.rtol = 1e-8, .atol = 1e-8});
-  odyn::advance_to(model, ws, integrator, 0.01, 1e-3);  // warm up
-  allocations = 0;
-  counting = true;
-  odyn::advance_to(model, ws, integrator, 0.1, 1e-3);
-  integrator.refresh_blocks();
-  counting = false;
-  CHECK(integrator.statistics().steps > 5);
-  CHECK(allocations == 0);
+  const auto check = [&]<class Integrator>(Integrator*) {
+    odyn::Workspace<Model> ws(model);
+    odyn::assemble(model, ws);
+    Integrator integrator(model, ws, {}, {.rtol = 1e-8, .atol = 1e-8});
+    odyn::advance_to(model, ws, integrator, 0.01, 1e-3);  // warm up
+    allocations = 0;
+    counting = true;
+    odyn::advance_to(model, ws, integrator, 0.1, 1e-3);
+    integrator.refresh_blocks();
+    counting = false;
+    CHECK(integrator.statistics().steps > 5);
+    CHECK(allocations == 0);
+  };
+  check(static_cast<odyn::JointDormandPrince853<Model>*>(nullptr));
+  check(static_cast<odyn::JointGeneralizedAlpha<Model>*>(nullptr));
 }
 
 TEST_CASE("a time step allocates nothing on the sparse paths (CHOLMOD's Schur complement, KLU)",

@@ -34,10 +34,10 @@ struct DynamicsSettings {
   /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
   /// control), "adams" (fixed step, order adams.order).
   std::string integrator = "generalized-alpha";
-  /// What dopri5, dop853 and adams step: "absolute" (every body's position and orientation,
-  /// every joint a constraint) or "joint" (a spanning tree's joint coordinates, only the joints
-  /// that close loops as constraints; spatial models; see analysis/joint_coordinates.hpp). The
-  /// other integrators step absolute coordinates.
+  /// What the integrator steps: "absolute" (every body's position and orientation, every joint
+  /// a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that close
+  /// loops as constraints; spatial models; see analysis/joint_coordinates.hpp). BDF steps
+  /// absolute coordinates only.
   std::string coordinates = "absolute";
   /// The factorization of the linear systems, in the assembly and the integrator: "auto"
   /// (dense for small models, sparse for large ones), "dense", "cholmod" or "klu"; see
@@ -389,10 +389,14 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
       if (s.integrator == "dop853")
         return simulate_with<JointDormandPrince853>(model, ws, s, observe);
       if (s.integrator == "adams") return simulate_with<JointAdamsBashforth>(model, ws, s, observe);
-      throw ModelError("dynamics", "joint coordinates run with dopri5, dop853 or adams, not '" +
-                                       s.integrator +
-                                       "'; choose one of those, or coordinates "
-                                       "'absolute' for this integrator");
+      if (s.integrator == "generalized-alpha" || s.integrator == "hht")
+        return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe);
+      throw ModelError("dynamics",
+                       "joint coordinates run with generalized-alpha, hht, dopri5, dop853 or "
+                       "adams, not '" +
+                           s.integrator +
+                           "'; choose one of those, or coordinates 'absolute' for this "
+                           "integrator");
     } else {
       throw ModelError("dynamics",
                        "joint coordinates are implemented for spatial models; planar models run "

@@ -305,12 +305,14 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     iteration of generalized-alpha and hht.
 
     coordinates: "absolute" (every body's position and orientation, every joint a constraint)
-    or, for spatial models with dopri5, dop853 or adams, "joint": the bodies located through a
+    or, for spatial models with any integrator but bdf, "joint": the bodies located through a
     spanning tree of revolute, translational, cylindrical, universal, fixed and spherical
     joints, only the joints that close loops (distances, drivers, the rest) as constraints.
     Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
-    dynamics); reactions and outputs are the same as in absolute coordinates. Redundant loop
-    closures are refused (absolute coordinates handle them).
+    dynamics); reactions and outputs are the same as in absolute coordinates. Generalized-alpha
+    and hht there iterate with the mass matrix alone (springs' stiffness and dampers stay out
+    of Newton's matrix: stiff ones take more iterations than in absolute coordinates). Redundant
+    loop closures are refused (absolute coordinates handle them).
 
     linear_solver: the factorization of the linear systems of the assembly and the steps.
     "auto" (the default) picks by size and pattern: dense kernels for small models (tens of

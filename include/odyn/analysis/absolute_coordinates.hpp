@@ -1,14 +1,20 @@
 #pragma once
-// The coordinates an explicit integrator steps, with the operations it needs on them. Here the
-// model's own: every body's position and orientation (absolute coordinates), all joints as
-// constraint equations. analysis/joint_coordinates.hpp offers the other choice.
+// The coordinates an integrator steps, with the operations it needs on them. Here the model's
+// own: every body's position and orientation (absolute coordinates), all joints as constraint
+// equations. analysis/joint_coordinates.hpp offers the other choice.
 //
-// The integrator's state is y = (positions, velocities); an operation reads and writes the
-// workspace, so that element blocks, events and observers see the bodies' frames either way.
+// Two views of one interface. An explicit integrator's state is y = (positions, velocities),
+// loaded and read back whole. An implicit one (generalized-alpha) iterates in place on the
+// coordinates' own vectors (positions(), velocities(), accelerations(), multipliers()), asks for
+// the residual of the equations of motion and solves with the Newton matrix. Either way an
+// operation reads and writes the workspace, so that element blocks, events and observers see
+// the bodies' frames.
 
 #include <Eigen/Core>
+#include <algorithm>
 
 #include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/minimum_norm.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/workspace.hpp"
@@ -26,9 +32,13 @@ class AbsoluteCoordinates {
       : model_(model),
         ws_(ws),
         projection_(model),
-        increment_(Eigen::VectorXd::Zero(model.num_velocities())) {
+        increment_(Eigen::VectorXd::Zero(model.num_velocities())),
+        inverse_mass_diagonal_(Eigen::VectorXd::Zero(model.num_velocities())) {
     solver_.choose(linear_solver);
     solver_.analyze(model);
+    for (int b = 1; b <= model.num_bodies(); ++b)
+      inverse_mass_diagonal_.template segment<Model::nv>((b - 1) * Model::nv) =
+          model.body(BodyId{b}).mass_block().diagonal().cwiseInverse();
   }
 
   Eigen::Index num_positions() const { return model_.num_coordinates(); }
@@ -45,7 +55,7 @@ class AbsoluteCoordinates {
     for (int b = 0; b < model_.num_bodies(); ++b)
       Model::Space::normalize(ws_.q.template segment<Model::nq>(b * Model::nq));
     ws_.v = y.tail(num_velocities());
-    update_frames(model_, ws_);
+    odyn::update_frames(model_, ws_);
   }
 
   /// The position rate q' for the velocities loaded last, at the positions held in y.
@@ -64,6 +74,13 @@ class AbsoluteCoordinates {
 
   const Eigen::VectorXd& accelerations() const { return ws_.vdot; }
   const Eigen::VectorXd& multipliers() const { return ws_.lambda; }
+  // An implicit integrator's iterate: the workspace's own q, v, v' and lambda.
+  Eigen::VectorXd& positions() { return ws_.q; }
+  Eigen::VectorXd& velocities() { return ws_.v; }
+  const Eigen::VectorXd& positions() const { return ws_.q; }
+  const Eigen::VectorXd& velocities() const { return ws_.v; }
+  Eigen::VectorXd& accelerations() { return ws_.vdot; }
+  Eigen::VectorXd& multipliers() { return ws_.lambda; }
   /// Puts back accelerations and multipliers solved earlier for the loaded state.
   void restore_solution(const Eigen::VectorXd& vdot, const Eigen::VectorXd& lambda) {
     ws_.vdot = vdot;
@@ -108,12 +125,77 @@ class AbsoluteCoordinates {
     projection_.correct_velocities(model_, ws_, solver_);
   }
 
+  // ---- What an implicit integrator asks for besides (see the file's comment).
+
+  /// The frames (positions and velocities) from positions() and velocities().
+  void update_frames() { odyn::update_frames(model_, ws_); }
+
+  /// to = from moved by a configuration increment (translations added, rotations composed on
+  /// the right).
+  void integrate(const Eigen::VectorXd& from, const Eigen::VectorXd& increment,
+                 Eigen::VectorXd& to) const {
+    constexpr int nq = Model::nq, nv = Model::nv;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      Model::Space::integrate(from.template segment<nq>(b * nq),
+                              increment.template segment<nv>(b * nv),
+                              to.template segment<nq>(b * nq));
+  }
+
+  /// M v' - Q + Phi_q^T lambda at the workspace's state (blocks and forces evaluated).
+  void dynamics_residual(Eigen::Ref<Eigen::VectorXd> out) const {
+    mass_times(model_, ws_.vdot, out);
+    out -= ws_.force;
+    add_jacobian_transpose_times(model_, ws_, ws_.lambda, out);
+  }
+
+  /// Phi at the loaded positions (constraints evaluated).
+  const Eigen::VectorXd& constraint_values() const { return ws_.phi; }
+
+  /// The Newton matrix [M + damping C + stiffness K, Phi_q^T; Phi_q, 0] (see IterationFactors).
+  bool factorize(const IterationFactors& factors) {
+    return solver_.factorize(model_, ws_, factors);
+  }
+  /// x = the factorized matrix's inverse times rhs (velocities, then equations).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) { solver_.solve(rhs, x); }
+  /// Equations that repeat others in the last factorization (run with minimum-norm multipliers).
+  int rank_deficiency() const { return static_cast<int>(solver_.rank_deficiency()); }
+  /// How much the geometric stiffness weighed in the last factorization (see the solver).
+  double geometric_share() const { return solver_.geometric_share(); }
+  /// With redundant equations, the multipliers of least norm among those that give the same
+  /// constraint forces (their reactions are then one choice among many).
+  void make_multipliers_unique() {
+    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
+  }
+
+  /// max |M^-1 r| by the mass matrix's diagonal: a cheap estimate of the next Newton correction
+  /// of v' for the residual r.
+  double estimated_correction(const Eigen::Ref<const Eigen::VectorXd>& r) const {
+    return r.cwiseProduct(inverse_mass_diagonal_).cwiseAbs().maxCoeff();
+  }
+
+  /// The scale of each velocity coordinate's error (see Space::coordinate_scale).
+  void error_scale(Eigen::VectorXd& out) const {
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      out.template segment<Model::nv>(b * Model::nv) =
+          Model::Space::coordinate_scale(ws_.q.template segment<Model::nq>(b * Model::nq));
+  }
+
+  /// The largest coordinate of a body's position: the rounding in Phi scales with it.
+  double largest_position() const {
+    double largest = 0.0;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      largest = std::max(
+          largest, ws_.q.template segment<Model::Space::dim>(b * Model::nq).cwiseAbs().maxCoeff());
+    return largest;
+  }
+
  private:
   const Model& model_;
   Workspace<Model>& ws_;
   Solver solver_;
   ConstraintProjection<Model> projection_;
   Eigen::VectorXd increment_;  // a position error in velocity coordinates
+  Eigen::VectorXd inverse_mass_diagonal_;
 };
 
 }  // namespace odyn

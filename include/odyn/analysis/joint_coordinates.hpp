@@ -44,6 +44,10 @@
 // bodies' own equations, leaves first (B B^T lambda = B (Q - M v' - the constraint forces
 // already known), B the joint's block on its child; exact, since the equations are consistent).
 //
+// An implicit integrator (generalized-alpha, HHT) iterates on q, theta', theta'' and lambda in
+// place: dynamics_residual() is the recursive Newton-Euler algorithm (the same passes with
+// theta'' given), and its Newton matrix is [A C^T; C 0], factorized as above.
+//
 // Limits: spatial models; loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
 
@@ -59,6 +63,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/rotation.hpp"
@@ -125,7 +130,7 @@ class JointCoordinates {
   JointCoordinates(const Model& model, Workspace<Model>& ws,
                    LinearSolver /*linear_solver*/ = LinearSolver::automatic)
       : model_(model), ws_(ws) {
-    update_frames(model, ws);
+    odyn::update_frames(model, ws);
     build_tree();
     size_buffers();
     initial_state();
@@ -252,6 +257,13 @@ class JointCoordinates {
 
   const Eigen::VectorXd& accelerations() const { return qdd_; }
   const Eigen::VectorXd& multipliers() const { return lambda_; }
+  // An implicit integrator's iterate: the joint coordinates, rates, their rates and lambda.
+  Eigen::VectorXd& positions() { return q_; }
+  Eigen::VectorXd& velocities() { return v_; }
+  const Eigen::VectorXd& positions() const { return q_; }
+  const Eigen::VectorXd& velocities() const { return v_; }
+  Eigen::VectorXd& accelerations() { return qdd_; }
+  Eigen::VectorXd& multipliers() { return lambda_; }
   void restore_solution(const Eigen::VectorXd& qdd, const Eigen::VectorXd& lambda) {
     qdd_ = qdd;
     lambda_ = lambda;
@@ -318,6 +330,133 @@ class JointCoordinates {
     saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
     v_ += increment_;
     update_velocities();
+  }
+
+  // ---- What an implicit integrator (generalized-alpha) asks for besides: it iterates on
+  // positions(), velocities(), accelerations() and multipliers() in place.
+
+  /// The frames, motion columns and twists from positions() and velocities().
+  void update_frames() { update_kinematics(); }
+
+  /// to = from moved by an increment in rate coordinates: a joint coordinate by its increment,
+  /// a ball joint's or free root's rotation composed on the right.
+  void integrate(const Eigen::VectorXd& from, const Eigen::VectorXd& increment,
+                 Eigen::VectorXd& to) const {
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free) {
+        Spatial::integrate(from.segment<Spatial::nq>(node.q_offset),
+                           increment.segment<Spatial::nv>(node.v_offset),
+                           to.segment<Spatial::nq>(node.q_offset));
+      } else if (node.kind == Kind::ball) {
+        to.segment<4>(node.q_offset) = from.segment<4>(node.q_offset);
+        turn(to.segment<4>(node.q_offset), increment.segment<3>(node.v_offset));
+      } else {
+        to.segment(node.q_offset, node.dof()) =
+            from.segment(node.q_offset, node.dof()) + increment.segment(node.v_offset, node.dof());
+      }
+    }
+  }
+
+  /// A theta'' + C^T lambda - J^T (Q - the velocity terms) at the loaded state, forces
+  /// evaluated, for the held theta'' and lambda: the recursive Newton-Euler algorithm, the
+  /// bodies' accelerations down the tree, then each body's unbalanced wrench, summed up the
+  /// tree and projected on its joint's motions. O(N).
+  void dynamics_residual(Eigen::Ref<Eigen::VectorXd> out) {
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const TreeBody& node = tree_[i];
+      Vector6 acceleration = nodes_[i].bias;
+      if (node.parent_node >= 0)
+        acceleration += shifted_motion(motion_[node.parent_node], nodes_[i].offset);
+      acceleration.noalias() +=
+          nodes_[i].motion.leftCols(node.dof()) * qdd_.segment(node.v_offset, node.dof());
+      motion_[i] = acceleration;
+      // The body's inertia times its acceleration, plus its velocity terms, less what acts on
+      // it (the gyroscopic torque is part of Q), at its centre in global axes.
+      const int b = node.body;
+      const auto& body = model_.body(BodyId{b});
+      const Eigen::Matrix3d& rotation = ws_.frames[b].rotation;
+      const Vector6& twist = nodes_[i].twist;
+      force_[i].head<3>().noalias() =
+          rotation * (body.inertia * (rotation.transpose() * acceleration.head<3>()) -
+                      ws_.force.template segment<3>(6 * (b - 1) + 3));
+      force_[i].tail<3>() =
+          body.mass * (acceleration.tail<3>() + twist.head<3>().cross(twist.tail<3>())) -
+          ws_.force.template segment<3>(6 * (b - 1));
+    }
+    add_closure_wrenches(lambda_, 1.0, force_);
+    for (std::size_t i = tree_.size(); i-- > 0;) {
+      const TreeBody& node = tree_[i];
+      out.segment(node.v_offset, node.dof()).noalias() =
+          nodes_[i].motion.leftCols(node.dof()).transpose() * force_[i];
+      if (node.parent_node >= 0)
+        add_shifted_force(force_[i], nodes_[i].offset, force_[node.parent_node]);
+    }
+  }
+
+  /// The closures' Phi at the loaded positions (constraints evaluated).
+  const Eigen::VectorXd& constraint_values() const { return phi_; }
+
+  /// The Newton matrix of an implicit integrator: [A C^T; C 0] with A the mass matrix in joint
+  /// coordinates. The forces' stiffness and damping and the derivatives of the velocity terms
+  /// and of A itself are left out (their factors are not used): in joint coordinates they
+  /// would couple the whole tree, and the iteration converges without them wherever the mass
+  /// over h^2 outweighs them.
+  bool factorize(const IterationFactors& /*factors*/) { return factorize(); }
+
+  /// x = [A C^T; C 0]^-1 rhs with the last factorization (rates, then closure equations).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
+    const Eigen::Index n = num_velocities(), m = num_equations();
+    joint_rhs_ = rhs.head(n);
+    closure_rhs_ = rhs.tail(m);
+    clear(force_);
+    saddle_solve(true, false, closure_rhs_, x.head(n), x.tail(m), &joint_rhs_);
+  }
+
+  // Redundant closures are refused at the start (check_closures), and the matrix leaves out
+  // the geometric stiffness.
+  int rank_deficiency() const { return 0; }
+  double geometric_share() const { return 0.0; }
+  void make_multipliers_unique() {}
+
+  /// max |A^-1 r|, one solve along the tree (the closures left out): the next Newton
+  /// correction of theta'' for the residual r, about.
+  double estimated_correction(const Eigen::Ref<const Eigen::VectorXd>& r) {
+    joint_rhs_ = r;
+    if (dense_) {
+      // The small models' factorization is of the whole saddle-point matrix: solve with it.
+      closure_rhs_.setZero();
+      clear(force_);
+      saddle_solve(true, false, closure_rhs_, estimate_, multiplier_, &joint_rhs_);
+    } else {
+      clear(force_);
+      tree_solve(false, estimate_, motion2_, &joint_rhs_);
+    }
+    return estimate_.cwiseAbs().maxCoeff();
+  }
+
+  /// The scale of each rate coordinate's error: a free root's as in Spatial, a sliding joint's
+  /// its travel, turns 1.
+  void error_scale(Eigen::VectorXd& out) const {
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free) {
+        out.segment<Spatial::nv>(node.v_offset) =
+            Spatial::coordinate_scale(q_.segment<Spatial::nq>(node.q_offset));
+      } else if (node.kind == Kind::ball) {
+        out.segment<3>(node.v_offset).setOnes();
+      } else {
+        for (int k = 0; k < node.dof(); ++k)
+          out[node.v_offset + k] =
+              node.screws[k].kind == Screw::Kind::rotation ? 1.0 : std::abs(q_[node.q_offset + k]);
+      }
+    }
+  }
+
+  /// The largest coordinate of a body's position: the rounding in Phi scales with it.
+  double largest_position() const {
+    double largest = 0.0;
+    for (const TreeBody& node : tree_)
+      largest = std::max(largest, ws_.frames[node.body].position.cwiseAbs().maxCoeff());
+    return largest;
   }
 
   /// Brings the whole workspace to the loaded state as an absolute-coordinate run leaves it:
@@ -557,13 +696,14 @@ class JointCoordinates {
   /// ABA's force step for node i: u = -S^T p, and the force the subtree hands its parent,
   /// p + I^a c + U D^-1 u, moved to the parent's centre (torque plus r x force).
   template <int K>
-  bool backward_node(std::size_t i, bool with_bias) {
+  bool backward_node(std::size_t i, bool with_bias, const Eigen::VectorXd* joint_force) {
     detail::TreeNodeState& node = nodes_[i];
     Vector6 handed = force_[i];
     if (with_bias) handed.noalias() += node.articulated * node.bias;
     if constexpr (K > 0) {
       auto u = node.pivot_force.template head<K>();
       u.noalias() = -(node.motion.template leftCols<K>().transpose() * force_[i]);
+      if (joint_force) u += joint_force->segment<K>(tree_[i].v_offset);
       handed.noalias() += node.projected.template leftCols<K>() *
                           (node.inverse_pivot.template topLeftCorner<K, K>() * u);
     }
@@ -592,13 +732,14 @@ class JointCoordinates {
     return true;
   }
 
-  /// x = A^-1 (J^T w) with the factorization of the last factorize(), and every body's motion
-  /// J x (+ c with_bias) into `acceleration`. force_ holds p = -w per body (plus the velocity
-  /// terms with_bias) and is used up.
-  void tree_solve(bool with_bias, Eigen::Ref<Eigen::VectorXd> x,
-                  std::vector<Vector6>& acceleration) {
+  /// x = A^-1 (J^T w + tau) with the factorization of the last factorize(), and every body's
+  /// motion J x (+ c with_bias) into `acceleration`. force_ holds p = -w per body (plus the
+  /// velocity terms with_bias) and is used up; tau (joint forces, per rate) may be absent.
+  void tree_solve(bool with_bias, Eigen::Ref<Eigen::VectorXd> x, std::vector<Vector6>& acceleration,
+                  const Eigen::VectorXd* joint_force = nullptr) {
     for (std::size_t i = tree_.size(); i-- > 0;)
-      with_dof(tree_[i].dof(), [&]<int K>() { return backward_node<K>(i, with_bias); });
+      with_dof(tree_[i].dof(),
+               [&]<int K>() { return backward_node<K>(i, with_bias, joint_force); });
     for (std::size_t i = 0; i < tree_.size(); ++i)
       with_dof(tree_[i].dof(),
                [&]<int K>() { return forward_node<K>(i, with_bias, x, acceleration); });
@@ -608,10 +749,11 @@ class JointCoordinates {
   /// x0 = A^-1 J^T w, mu = (C A^-1 C^T)^-1 (C x0 - s), x = x0 - A^-1 C^T mu. With bias, C x0
   /// includes Phi_q c (s then stands for gamma in spatial form). motion_ ends with J x (+ c).
   void saddle_solve(bool with_force, bool with_bias, const Eigen::VectorXd& s,
-                    Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu) {
-    if (dense_) return saddle_solve_dense(with_force, with_bias, s, x, mu);
+                    Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu,
+                    const Eigen::VectorXd* joint_force = nullptr) {
+    if (dense_) return saddle_solve_dense(with_force, with_bias, s, x, mu, joint_force);
     if (with_force || with_bias) {
-      tree_solve(with_bias, x, motion_);
+      tree_solve(with_bias, x, motion_, joint_force);
     } else {
       x.setZero();
       clear(motion_);
@@ -632,7 +774,8 @@ class JointCoordinates {
   /// saddle_solve with the factorized saddle-point matrix: [A C^T; C 0] [x; mu] =
   /// [-J^T (p + M c); s - Phi_q c], c the bodies' accelerations at zero theta'' (with_bias).
   void saddle_solve_dense(bool with_force, bool with_bias, const Eigen::VectorXd& s,
-                          Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu) {
+                          Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> mu,
+                          const Eigen::VectorXd* joint_force) {
     const Eigen::Index n = num_velocities();
     solution_.tail(num_equations()) = s;
     if (with_bias) {
@@ -654,7 +797,8 @@ class JointCoordinates {
       for (std::size_t i = tree_.size(); i-- > 0;) {
         const TreeBody& node = tree_[i];
         for (int k = 0; k < node.dof(); ++k)
-          solution_[node.v_offset + k] = -nodes_[i].motion.col(k).dot(force_[i]);
+          solution_[node.v_offset + k] = -nodes_[i].motion.col(k).dot(force_[i]) +
+                                         (joint_force ? (*joint_force)[node.v_offset + k] : 0.0);
         if (node.parent_node >= 0)
           add_shifted_force(force_[i], nodes_[i].offset, force_[node.parent_node]);
       }
@@ -856,6 +1000,8 @@ class JointCoordinates {
     increment_.setZero(n);
     increment2_.setZero(n);
     closure_step_.setZero(n);
+    joint_rhs_.setZero(n);
+    estimate_.setZero(n);
   }
 
   /// Joint coordinates 0 at the start (quaternions 1), free roots where they are; the rates
@@ -1104,6 +1250,7 @@ class JointCoordinates {
   Eigen::LLT<Eigen::MatrixXd> schur_llt_;
   Eigen::VectorXd increment_, increment2_;  // (n) scratch
   Eigen::VectorXd closure_step_;            // (n) saddle_solve's own scratch
+  Eigen::VectorXd joint_rhs_, estimate_;    // (n) an implicit integrator's solves (scratch)
   Eigen::VectorXd qdd_, lambda_;            // (n), (m) of the last solve_accelerations
 };
 

@@ -8,6 +8,13 @@
 // Newton runs on the scaled iteration matrix [M + gamma' C + beta' K, Phi_q^T; Phi_q, 0]
 // (constraint rows divided by beta h^2 (1-alpha_f)/(1-alpha_m)), whose factorization is kept
 // across iterations and steps until convergence slows down.
+//
+// What it steps is a template parameter (analysis/absolute_coordinates.hpp): the bodies' own
+// coordinates (GeneralizedAlpha), or a spanning tree's joint coordinates with the loop
+// closures as constraints (JointGeneralizedAlpha), where q, v and v' are joint coordinates,
+// rates and their rates, and the Newton matrix holds the mass matrix in joint coordinates,
+// factorized by the articulated-body algorithm (the forces' stiffness and damping and the
+// velocity terms' derivatives stay out of it there: a modified Newton iteration).
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -15,9 +22,9 @@
 #include <limits>
 #include <string>
 
-#include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/absolute_coordinates.hpp"
 #include "odyn/analysis/diagnosis.hpp"
-#include "odyn/analysis/minimum_norm.hpp"
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -51,22 +58,20 @@ struct GeneralizedAlphaSettings {
   LinearSolver linear_solver = LinearSolver::automatic;
 };
 
-template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
-class GeneralizedAlpha {
+template <class Model, class Coordinates = AbsoluteCoordinates<Model>>
+class GeneralizedAlphaMethod {
  public:
   using Settings = GeneralizedAlphaSettings;
   static constexpr bool retries_shorter_steps = true;  // a failure is Newton's (see attempt)
-  static constexpr int nv = Model::nv;
-  static constexpr int nq = Model::nq;
 
-  GeneralizedAlpha(const Model& model, Workspace<Model>& ws, Settings settings = {},
-                   StepControl control = {})
+  GeneralizedAlphaMethod(const Model& model, Workspace<Model>& ws, Settings settings = {},
+                         StepControl control = {})
       : model_(model),
         ws_(ws),
         settings_(settings),
         control_(control),
         proposed_step_(std::min(control.first_step, control.max_step)),
-        projection_(model) {
+        coordinates_(model, ws, settings.linear_solver) {
     if (settings.adaptive &&
         (!(control.rtol > 0.0) || !(control.atol > 0.0) || !(proposed_step_ > 0.0)))
       throw ModelError(settings.hht ? "hht" : "generalized-alpha",
@@ -88,8 +93,8 @@ class GeneralizedAlpha {
     gamma_ = 0.5 + alpha_f_ - alpha_m_;
     beta_ = 0.25 * (gamma_ + 0.5) * (gamma_ + 0.5);
 
-    nv_total_ = model.num_velocities();
-    m_ = model.num_equations();
+    nv_total_ = static_cast<int>(coordinates_.num_velocities());
+    m_ = static_cast<int>(coordinates_.num_equations());
     const int n = nv_total_ + m_;
     residual_ = Eigen::VectorXd::Zero(n);
     correction_ = Eigen::VectorXd::Zero(n);
@@ -102,12 +107,6 @@ class GeneralizedAlpha {
     // q(t + h) - q_{n+1} = c h^3 (d/dt)^3 q + O(h^4) when a_n stands for v' at
     // t_n + (alpha_m - alpha_f) h: the constant c of the position update's local error.
     error_constant_ = beta_ - 1.0 / 6.0 + 0.5 * (alpha_m_ - alpha_f_);
-    inverse_mass_diagonal_ = Eigen::VectorXd::Zero(nv_total_);
-    for (int b = 1; b <= model.num_bodies(); ++b)
-      inverse_mass_diagonal_.template segment<nv>((b - 1) * nv) =
-          model.body(BodyId{b}).mass_block().diagonal().cwiseInverse();
-    solver_.choose(settings.linear_solver);
-    solver_.analyze(model);
     initialize();
   }
 
@@ -115,11 +114,11 @@ class GeneralizedAlpha {
   /// lambda solved from it: a_0 = v'_0.
   void initialize() {
     t_n_ = ws_.t;
-    q_n_ = ws_.q;
-    v_n_ = ws_.v;
-    vdot_n_ = ws_.vdot;
-    a_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    q_n_ = coordinates_.positions();
+    v_n_ = coordinates_.velocities();
+    vdot_n_ = coordinates_.accelerations();
+    a_n_ = vdot_n_;
+    lambda_n_ = coordinates_.multipliers();
     vdot_previous_ = vdot_n_;
     lambda_previous_ = lambda_n_;
     restart();
@@ -193,20 +192,21 @@ class GeneralizedAlpha {
   /// Accepts the trial state of the last successful attempt.
   void commit() {
     // Redundant constraints never take the contraction shortcut, so the blocks are current here.
-    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
+    coordinates_.make_multipliers_unique();
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     a_previous_ = a_step_;
-    a_n_ =
-        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / (1.0 - alpha_m_);
+    a_n_ = ((1.0 - alpha_f_) * coordinates_.accelerations() + alpha_f_ * vdot_n_ -
+            alpha_m_ * a_step_) /
+           (1.0 - alpha_m_);
     vdot_previous_ = vdot_n_;
     lambda_previous_ = lambda_n_;
     previous_step_ = h_;
     previous_local_error_ = local_error_.cwiseAbs().maxCoeff();
     starting_ = false;
-    q_n_ = ws_.q;
-    v_n_ = ws_.v;
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    q_n_ = coordinates_.positions();
+    v_n_ = coordinates_.velocities();
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     t_n_ = ws_.t;
     advance_states(model_, ws_);
     ++statistics_.steps;
@@ -227,16 +227,16 @@ class GeneralizedAlpha {
   /// starts in v' and lambda. v'' comes from consistent accelerations a short time later.
   void restart() {
     consistent_accelerations();
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     // A short Taylor step along the motion, then v'' by a finite difference.
     const double delta = 1e-6 * std::max(std::abs(t_n_), 1.0) + (h_ > 0.0 ? 1e-2 * h_ : 0.0);
     increment_ = delta * v_n_ + 0.5 * delta * delta * vdot_n_;
     move_positions();
-    ws_.v = v_n_ + delta * vdot_n_;
+    coordinates_.velocities() = v_n_ + delta * vdot_n_;
     ws_.t = t_n_ + delta;
     consistent_accelerations();
-    jerk_ = (ws_.vdot - vdot_n_) / delta;
+    jerk_ = (coordinates_.accelerations() - vdot_n_) / delta;
     a_n_ = vdot_n_;
     starting_ = true;
     previous_step_ = 0.0;  // no extrapolation across the discontinuity
@@ -246,24 +246,29 @@ class GeneralizedAlpha {
 
   /// Evaluates Phi, its Jacobian blocks and the forces at the workspace's state, if the last
   /// step was accepted on Newton's contraction estimate and left them one iterate behind.
+  /// In joint coordinates, also fills in the workspace as an absolute-coordinate run leaves it
+  /// (q, v, v', every joint's lambda; see JointCoordinates::complete_workspace).
   void refresh_blocks() {
-    if (!blocks_stale_) return;
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
-    blocks_stale_ = false;
+    if (blocks_stale_) {
+      coordinates_.evaluate_constraints();
+      coordinates_.evaluate_forces();
+      blocks_stale_ = false;
+    }
+    if constexpr (requires { coordinates_.complete_workspace(); })
+      coordinates_.complete_workspace();
   }
 
   /// Puts the workspace back at the last committed state, its blocks and forces evaluated there
   /// (a restart leaves them at a probe a microsecond later otherwise).
   void rollback() {
-    ws_.q = q_n_;
-    ws_.v = v_n_;
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
+    coordinates_.positions() = q_n_;
+    coordinates_.velocities() = v_n_;
+    coordinates_.accelerations() = vdot_n_;
+    coordinates_.multipliers() = lambda_n_;
     ws_.t = t_n_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
     blocks_stale_ = false;
   }
 
@@ -288,15 +293,15 @@ class GeneralizedAlpha {
   /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the workspace's
   /// state. Uses the iteration matrix's storage; the next step factorizes afresh.
   void consistent_accelerations() {
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
     ++statistics_.factorizations;
     factorized_ = false;
-    if (!solver_.factorize(model_, ws_, IterationFactors{}))
+    if (!coordinates_.factorize(IterationFactors{}))
       throw SolverError(ws_.t,
                         "the mass-constraint matrix is singular; check for redundant or "
                         "locked constraints");
-    projection_.solve_accelerations(model_, ws_, solver_);
+    coordinates_.solve_accelerations();
   }
 
   /// The state at t_{n+1} from the current guess of v'_{n+1}, written into the workspace.
@@ -304,9 +309,10 @@ class GeneralizedAlpha {
     const double h = h_;
     const double one_minus_am = 1.0 - alpha_m_;
     // a_{n+1} stored in increment_ first, then turned into the configuration increment.
-    increment_ =
-        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / one_minus_am;
-    ws_.v = v_n_ + h * (1.0 - gamma_) * a_step_ + h * gamma_ * increment_;
+    increment_ = ((1.0 - alpha_f_) * coordinates_.accelerations() + alpha_f_ * vdot_n_ -
+                  alpha_m_ * a_step_) /
+                 one_minus_am;
+    coordinates_.velocities() = v_n_ + h * (1.0 - gamma_) * a_step_ + h * gamma_ * increment_;
     increment_ = h * v_n_ + h * h * (0.5 - beta_) * a_step_ + h * h * beta_ * increment_;
     move_positions();
     ws_.t = t_new;
@@ -317,13 +323,9 @@ class GeneralizedAlpha {
   /// control shrank is not short: it is what the control asked for.)
   double usual_step() const { return settings_.adaptive ? proposed_step_ : reference_step_; }
 
-  /// ws.q = q_n moved by increment_ (translations added, rotations composed on the right).
-  void move_positions() {
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Model::Space::integrate(q_n_.template segment<nq>(b * nq),
-                              increment_.template segment<nv>(b * nv),
-                              ws_.q.template segment<nq>(b * nq));
-  }
+  /// The positions = q_n moved by increment_ (translations added, rotations composed on the
+  /// right).
+  void move_positions() { coordinates_.integrate(q_n_, increment_, coordinates_.positions()); }
 
   /// A step of less than a thousandth of the usual one: the motion continued by its Taylor
   /// expansion, v' and lambda kept. Phi changes by about h |Phi_q v + Phi_t| (tens of
@@ -334,39 +336,35 @@ class GeneralizedAlpha {
     const double h = h_;
     increment_ = h * v_n_ + (0.5 * h * h) * vdot_n_;
     move_positions();
-    ws_.v = v_n_ + h * vdot_n_;
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
+    coordinates_.velocities() = v_n_ + h * vdot_n_;
+    coordinates_.accelerations() = vdot_n_;
+    coordinates_.multipliers() = lambda_n_;
     ws_.t = t_new;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
   }
 
   /// Residual of the step equations at the workspace's state; false if it is not finite.
   bool evaluate_residual() {
     ++statistics_.residual_evaluations;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
-    auto dynamics = residual_.head(nv_total_);
-    mass_times(model_, ws_.vdot, dynamics);
-    dynamics -= ws_.force;
-    add_jacobian_transpose_times(model_, ws_, ws_.lambda, dynamics);
-    residual_.tail(m_) = ws_.phi / position_factor();
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
+    coordinates_.dynamics_residual(residual_.head(nv_total_));
+    residual_.tail(m_) = coordinates_.constraint_values() / position_factor();
     return all_finite(residual_);
   }
 
   /// Local error of the positions, c h^2 (a_{n+1} - a_n) in the bodies' tangent coordinates
   /// (Geradin & Cardona, "Flexible Multibody Dynamics", Sect. 13.6), weighted by the tolerances.
   void estimate_error() {
-    local_error_ =
-        ((1.0 - alpha_f_) * ws_.vdot + alpha_f_ * vdot_n_ - alpha_m_ * a_step_) / (1.0 - alpha_m_) -
-        a_step_;
+    local_error_ = ((1.0 - alpha_f_) * coordinates_.accelerations() + alpha_f_ * vdot_n_ -
+                    alpha_m_ * a_step_) /
+                       (1.0 - alpha_m_) -
+                   a_step_;
     local_error_ *= error_constant_ * h_ * h_;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      error_scale_.template segment<nv>(b * nv) =
-          Model::Space::coordinate_scale(ws_.q.template segment<nq>(b * nq));
+    coordinates_.error_scale(error_scale_);
     error_ =
         weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol, control_.atol);
   }
@@ -382,22 +380,24 @@ class GeneralizedAlpha {
   bool factorize() {
     ++statistics_.factorizations;
     ++statistics_.jacobian_evaluations;
-    factorized_ = solver_.factorize(
-        model_, ws_, IterationFactors{1.0, position_factor(), velocity_factor(), geometric_});
+    factorized_ = coordinates_.factorize(
+        IterationFactors{1.0, position_factor(), velocity_factor(), geometric_});
     // The geometric stiffness leaves the matrix again once it weighs too little to matter.
-    if (geometric_ && solver_.geometric_share() < 0.01) geometric_ = false;
+    if (geometric_ && coordinates_.geometric_share() < 0.01) geometric_ = false;
     return factorized_;
   }
 
   bool solve_step(double t_new) {
     // Predictor: v' and lambda extrapolated linearly from the last two steps.
+    Eigen::VectorXd& vdot = coordinates_.accelerations();
+    Eigen::VectorXd& lambda = coordinates_.multipliers();
     if (previous_step_ > 0.0) {
       const double ratio = h_ / previous_step_;
-      ws_.vdot = vdot_n_ + ratio * (vdot_n_ - vdot_previous_);
-      ws_.lambda = lambda_n_ + ratio * (lambda_n_ - lambda_previous_);
+      vdot = vdot_n_ + ratio * (vdot_n_ - vdot_previous_);
+      lambda = lambda_n_ + ratio * (lambda_n_ - lambda_previous_);
     } else {
-      ws_.vdot = vdot_n_;
-      ws_.lambda = lambda_n_;
+      vdot = vdot_n_;
+      lambda = lambda_n_;
     }
     update_state(t_new);
     // Correction sizes are measured in units of the tight tolerance; times `loose` they are in
@@ -414,15 +414,13 @@ class GeneralizedAlpha {
     factorized_at_ = -1;  // the iterate of the matrix in use: before this step
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
-      const double phi_norm = m_ == 0 ? 0.0 : ws_.phi.cwiseAbs().maxCoeff();
+      const double phi_norm =
+          m_ == 0 ? 0.0 : coordinates_.constraint_values().cwiseAbs().maxCoeff();
       // Converged when Phi is satisfied and the last correction, or the next one as estimated
       // from the residual, is within tolerance.
       // The next correction is estimated from the residual with the mass matrix's diagonal.
       const double next_norm =
-          k > 0 ? velocity_factor() *
-                      (residual_.head(nv_total_).cwiseProduct(inverse_mass_diagonal_))
-                          .cwiseAbs()
-                          .maxCoeff() /
+          k > 0 ? velocity_factor() * coordinates_.estimated_correction(residual_.head(nv_total_)) /
                       tolerance
                 : 0.0;
       // Short of the tight tolerance, the ordinary one does when iterating no longer helps:
@@ -440,9 +438,9 @@ class GeneralizedAlpha {
         if (!factorize()) return false;
         factorized_at_ = k;
       }
-      solver_.solve(residual_, correction_);
-      ws_.vdot -= correction_.head(nv_total_);
-      ws_.lambda -= correction_.tail(m_);
+      coordinates_.solve(residual_, correction_);
+      vdot -= correction_.head(nv_total_);
+      lambda -= correction_.tail(m_);
       ++statistics_.newton_iterations;
       // Size of the velocity correction in units of the tolerance.
       const double norm =
@@ -464,11 +462,11 @@ class GeneralizedAlpha {
       // blocks then stay those of the last iterate until refresh_blocks(), which the driver
       // calls at outputs. Redundant constraints always get the confirming evaluation: their
       // minimum-norm corrections do not contract as regularly.
-      if (k > 0 && solver_.rank_deficiency() == 0) {
+      if (k > 0 && coordinates_.rank_deficiency() == 0) {
         const double phi_rate = m_ == 0 ? 0.0 : phi_norm / previous_phi_norm;
         if (rate < 0.5 && rate / (1.0 - rate) * norm <= 1.0 && phi_rate < 0.5 &&
             10.0 * phi_rate * phi_norm <= settings_.constraint_tolerance) {
-          update_frames(model_, ws_);
+          coordinates_.update_frames();
           blocks_stale_ = true;
           if (k + 1 > settings_.reuse_iterations) factorized_ = false;
           return true;
@@ -509,16 +507,12 @@ class GeneralizedAlpha {
   /// step's position error per unit time, scaled by (h / h_last)^3. Rounding may stop Newton
   /// short of it; the iteration then settles for the ordinary tolerance (see solve_step).
   NewtonTolerance newton_tolerance() const {
-    const double largest_velocity = ws_.v.cwiseAbs().maxCoeff();
+    const double largest_velocity = coordinates_.velocities().cwiseAbs().maxCoeff();
     // Rounding in v, and in Phi (whose terms are about as large as the bodies' positions),
     // divided by h to turn it into velocity. Far from the origin (a rope of 2 km) it exceeds
     // the settings' tolerance, which then cannot be met: the ordinary tolerance is never
     // below a few times the rounding.
-    double largest_position = 0.0;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      largest_position =
-          std::max(largest_position,
-                   ws_.q.template segment<Model::Space::dim>(b * nq).cwiseAbs().maxCoeff());
+    const double largest_position = coordinates_.largest_position();
     const double rounding =
         std::numeric_limits<double>::epsilon() * (largest_velocity + largest_position / h_);
     const double ordinary =
@@ -569,16 +563,22 @@ class GeneralizedAlpha {
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start
   double previous_local_error_ = 0.0;  // largest entry of its local position error estimate
   double reference_step_ = 0.0;        // the recent steps' size: max(h, half the last reference)
-  Eigen::VectorXd inverse_mass_diagonal_;  // (nv_total)
-  Eigen::VectorXd jerk_;                   // (nv_total) v'' at the last restart
-  bool starting_ = false;                  // the next step is the first after a restart
-  Eigen::VectorXd increment_;              // (nv_total) configuration increment
-  Eigen::VectorXd a_step_;      // (nv_total) a_n shifted to the size of the attempted step
-  Eigen::VectorXd a_previous_;  // (nv_total) a_{n-1}
+  Eigen::VectorXd jerk_;               // (nv_total) v'' at the last restart
+  bool starting_ = false;              // the next step is the first after a restart
+  Eigen::VectorXd increment_;          // (nv_total) configuration increment
+  Eigen::VectorXd a_step_;             // (nv_total) a_n shifted to the size of the attempted step
+  Eigen::VectorXd a_previous_;         // (nv_total) a_{n-1}
   Eigen::VectorXd local_error_, error_scale_;  // (nv_total)
-  Solver solver_;
-  ConstraintProjection<Model> projection_;
+  Coordinates coordinates_;  // what the steps move: q, v, v' and lambda live there
   IntegratorStatistics statistics_;
 };
+
+/// Generalized-alpha (and HHT) in absolute coordinates, with the saddle-point solver `Solver`.
+template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
+using GeneralizedAlpha = GeneralizedAlphaMethod<Model, AbsoluteCoordinates<Model, Solver>>;
+
+/// Generalized-alpha (and HHT) in joint coordinates (spatial models).
+template <class Model>
+using JointGeneralizedAlpha = GeneralizedAlphaMethod<Model, JointCoordinates<Model>>;
 
 }  // namespace odyn
