@@ -310,9 +310,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     joints, only the joints that close loops (distances, drivers, the rest) as constraints.
     Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
     dynamics); reactions and outputs are the same as in absolute coordinates. Generalized-alpha
-    and hht there iterate with the mass matrix alone (springs' stiffness and dampers stay out
-    of Newton's matrix: stiff ones take more iterations than in absolute coordinates). Redundant
-    loop closures are refused (absolute coordinates handle them).
+    and hht there leave the spring and damper blocks that join two bodies out of Newton's
+    matrix: stiff ones converge better in absolute coordinates. Redundant loop closures are
+    refused (absolute coordinates handle them).
 
     linear_solver: the factorization of the linear systems of the assembly and the steps.
     "auto" (the default) picks by size and pattern: dense kernels for small models (tens of

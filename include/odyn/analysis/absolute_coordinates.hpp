@@ -26,6 +26,8 @@ template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
 class AbsoluteCoordinates {
  public:
   static constexpr const char* name = "absolute";
+  /// What an implicit integrator's failure message adds: nothing here.
+  static constexpr const char* newton_advice = "";
 
   AbsoluteCoordinates(const Model& model, Workspace<Model>& ws,
                       LinearSolver linear_solver = LinearSolver::automatic)

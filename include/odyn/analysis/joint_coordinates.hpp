@@ -46,7 +46,9 @@
 //
 // An implicit integrator (generalized-alpha, HHT) iterates on q, theta', theta'' and lambda in
 // place: dynamics_residual() is the recursive Newton-Euler algorithm (the same passes with
-// theta'' given), and its Newton matrix is [A C^T; C 0], factorized as above.
+// theta'' given), and its Newton matrix is [A C^T; C 0], factorized as above, with each body's
+// own blocks of the springs' and dampers' stiffness and damping added to its inertia (see
+// factorize(const IterationFactors&)).
 //
 // Limits: spatial models; loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
@@ -123,6 +125,11 @@ class JointCoordinates {
   /// formed and factorized whole (L D L^T, unrolled for small sizes), which costs less than the
   /// recursive passes on models of a few bodies, such as the engine; above it, the passes.
   static constexpr Eigen::Index dense_limit = 24;
+  /// What an implicit integrator's failure message adds (see factorize(IterationFactors)).
+  static constexpr const char* newton_advice =
+      " In joint coordinates Newton's matrix keeps only each body's own blocks of the springs and "
+      "dampers: where stiff ones join two bodies, absolute coordinates (coordinates 'absolute') "
+      "converge better.";
 
   /// Builds the tree at the workspace's (assembled) state and takes that state as the start.
   /// Throws ModelError if the loop closures are redundant there.
@@ -194,6 +201,13 @@ class JointCoordinates {
   /// tree) and the closures' Schur complement C A^-1 C^T. False if A or the Schur complement
   /// is not positive definite (or the saddle-point matrix has a pivot of the wrong sign).
   bool factorize() {
+    load_inertias();
+    return factorize_loaded();
+  }
+
+  /// The bodies' inertias at their centres, global axes, into the articulated inertias that
+  /// factorize_loaded() starts from.
+  void load_inertias() {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const auto& body = model_.body(BodyId{tree_[i].body});
       const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
@@ -202,6 +216,9 @@ class JointCoordinates {
       inertia.topLeftCorner<3, 3>().noalias() = rotation * body.inertia * rotation.transpose();
       inertia.bottomRightCorner<3, 3>().diagonal().setConstant(body.mass);
     }
+  }
+
+  bool factorize_loaded() {
     if (dense_) return factorize_dense();
     for (std::size_t i = tree_.size(); i-- > 0;) {
       const bool positive = with_dof(tree_[i].dof(), [&]<int K>() { return factor_node<K>(i); });
@@ -397,11 +414,19 @@ class JointCoordinates {
   const Eigen::VectorXd& constraint_values() const { return phi_; }
 
   /// The Newton matrix of an implicit integrator: [A C^T; C 0] with A the mass matrix in joint
-  /// coordinates. The forces' stiffness and damping and the derivatives of the velocity terms
-  /// and of A itself are left out (their factors are not used): in joint coordinates they
-  /// would couple the whole tree, and the iteration converges without them wherever the mass
-  /// over h^2 outweighs them.
-  bool factorize(const IterationFactors& /*factors*/) { return factorize(); }
+  /// coordinates plus J^T (stiffness K + damping C) J, where K and C keep only each body's own
+  /// blocks of the force elements' stiffness and damping (and of its gyroscopic terms), their
+  /// symmetric part: the blocks that couple two bodies would couple the whole tree, and leaving
+  /// them out keeps A's recursive factorization. The derivatives of A itself and of the
+  /// velocity terms of the tree are left out too: a modified Newton iteration, which converges
+  /// wherever the mass over h^2 and the bodies' own blocks outweigh what it leaves out.
+  bool factorize(const IterationFactors& factors) {
+    if (factors.stiffness == 0.0 && factors.damping == 0.0) return factorize();
+    load_inertias();
+    add_own_force_blocks(factors.stiffness, factors.damping);
+    if (factorize_loaded()) return true;
+    return factorize();  // the blocks spoiled positive definiteness: the mass matrix alone
+  }
 
   /// x = [A C^T; C 0]^-1 rhs with the last factorization (rates, then closure equations).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
@@ -607,6 +632,45 @@ class JointCoordinates {
     out.head<3>() = a.head<3>().cross(b.head<3>());
     out.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
     return out;
+  }
+
+  /// Adds to each body's inertia (factorize_loaded's start) the symmetric part of its own blocks
+  /// stiffness_factor K_bb + damping_factor C_bb of the force elements and of the gyroscopic
+  /// terms, turned from the bodies' velocity coordinates (v_centre, omega in body axes) to the
+  /// spatial form at the centre (omega, v_centre in global axes): T^T B T, T = [0 1; R^T 0].
+  void add_own_force_blocks(double stiffness_factor, double damping_factor) {
+    using Block = typename Spatial::MassBlock;
+    for (int b = 1; b <= model_.num_bodies(); ++b)
+      own_blocks_[b] = damping_factor *
+                       Spatial::gyroscopic_damping(model_.body(BodyId{b}).inertia, ws_.frames[b]);
+    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+      if constexpr (HasForceJacobians<E>) {
+        ForceBlocksOf<E> blocks;
+        for (const E& element : pool) {
+          element.jacobians(detail::input_of(element, ws_.frames, ws_.t), blocks);
+          for (int k = 0; k < E::num_bodies; ++k) {
+            const int b = element.bodies()[k].index;
+            if (b == 0) continue;
+            own_blocks_[b] +=
+                stiffness_factor * blocks.stiffness.template block<6, 6>(6 * k, 6 * k) +
+                damping_factor * blocks.damping.template block<6, 6>(6 * k, 6 * k);
+          }
+        }
+      }
+    });
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      const int b = tree_[i].body;
+      const Block symmetric = 0.5 * (own_blocks_[b] + own_blocks_[b].transpose());
+      const Eigen::Matrix3d& rotation = ws_.frames[b].rotation;
+      // B = [B_vv B_vw; B_wv B_ww] in (v, omega_body); spatial (omega, v): T^T B T.
+      Matrix6& inertia = nodes_[i].articulated;
+      inertia.topLeftCorner<3, 3>().noalias() +=
+          rotation * symmetric.bottomRightCorner<3, 3>() * rotation.transpose();
+      const Eigen::Matrix3d coupling = rotation * symmetric.bottomLeftCorner<3, 3>();
+      inertia.topRightCorner<3, 3>() += coupling;
+      inertia.bottomLeftCorner<3, 3>() += coupling.transpose();
+      inertia.bottomRightCorner<3, 3>() += symmetric.topLeftCorner<3, 3>();
+    }
   }
 
   /// ABA's inertia step for node i: U, D^-1, I^A - U D^-1 U^T, which the parent inherits
@@ -978,6 +1042,8 @@ class JointCoordinates {
   void size_buffers() {
     const Eigen::Index n = num_velocities(), m = num_equations();
     nodes_.assign(tree_.size(), detail::TreeNodeState{});
+    own_blocks_.assign(static_cast<std::size_t>(model_.num_bodies() + 1),
+                       Spatial::MassBlock::Zero());
     force_.assign(tree_.size(), Vector6::Zero());
     motion_ = force_;
     motion2_ = force_;
@@ -1233,9 +1299,10 @@ class JointCoordinates {
   std::vector<std::string> tree_names_, closure_names_;
 
   std::vector<detail::TreeNodeState> nodes_;
-  std::vector<Vector6> force_;             // per node: p in a solve (scratch)
-  std::vector<Vector6> motion_, motion2_;  // per node: J x (+ c) of a solve (scratch)
-  std::vector<Vector6> closure_motion_;    // per node: saddle_solve's own scratch
+  std::vector<typename Spatial::MassBlock> own_blocks_;  // per body: see add_own_force_blocks
+  std::vector<Vector6> force_;                           // per node: p in a solve (scratch)
+  std::vector<Vector6> motion_, motion2_;                // per node: J x (+ c) of a solve (scratch)
+  std::vector<Vector6> closure_motion_;                  // per node: saddle_solve's own scratch
 
   Eigen::VectorXd q_, v_;             // (nq), (n) joint coordinates and rates
   Eigen::VectorXd constraint_force_;  // (6 nb) Phi_q^T lambda, in complete_workspace()

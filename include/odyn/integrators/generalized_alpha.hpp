@@ -537,7 +537,8 @@ class GeneralizedAlphaMethod {
                 : "Reduce the step size (h = " + to_text(h_) +
                       " s) or let error control choose it (adaptive = true; in Python and on "
                       "the command line, give rtol/atol), ") +
-           "check the force elements' parameters, or look for a locked or singular mechanism.";
+           "check the force elements' parameters, or look for a locked or singular mechanism." +
+           Coordinates::newton_advice;
   }
 
   const Model& model_;
