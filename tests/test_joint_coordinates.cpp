@@ -25,6 +25,7 @@
 #include "engine_model.hpp"
 #include "reference/engine_reference.hpp"
 #include "reference/steady_top.hpp"
+#include "rope_model.hpp"
 
 namespace test_joint_coordinates {
 
@@ -88,6 +89,24 @@ ChainModel chain() {
   return model;
 }
 
+/// The bearing force's scale: the reference's largest |R_z|.
+double peak_bearing_force(const std::vector<engine_reference::Sample>& reference) {
+  double peak = 0.0;
+  for (const auto& sample : reference) peak = std::max(peak, std::abs(sample.R_z));
+  return peak;
+}
+
+/// The bearing force jumps with the gas force, twice per cycle: reactions are compared away
+/// from those crank angles.
+bool near_force_jump(double theta) {
+  const double phase = std::fmod(theta, 4.0 * std::numbers::pi);
+  return std::abs(phase - 2.0 * std::numbers::pi) < 0.05 ||
+         std::abs(phase - 3.0 * std::numbers::pi) < 0.05;
+}
+
+using RopeModel = rope_model::Model;
+using rope_model::rope;
+
 struct ChainRun {
   std::vector<Eigen::VectorXd> positions;  // every body's centre and rotation, per output
   double energy_drift = 0.0;
@@ -137,8 +156,7 @@ TEST_CASE("Joint coordinates: the engine's tree closes at the crank pin", "[join
 TEST_CASE("Joint coordinates: the engine against its minimal-coordinate solution",
           "[joint][engine]") {
   const auto reference = engine_reference::solve(1.0, 1e-3);
-  double peak = 0.0;
-  for (const auto& sample : reference) peak = std::max(peak, std::abs(sample.R_z));
+  const double peak = peak_bearing_force(reference);
   engine::Engine e = engine::build();
   odyn::Workspace<engine::Model> ws(e.model);
   std::size_t k = 0;
@@ -147,11 +165,7 @@ TEST_CASE("Joint coordinates: the engine against its minimal-coordinate solution
       odyn::simulate(e.model, ws, joint_settings("dop853", 1e-9), [&](const auto& state) {
         const auto& sample = reference.at(k++);
         z_error = std::max(z_error, std::abs(engine::piston_height(e, state) - sample.z_piston));
-        // The reaction jumps with the gas force: compare away from the two jumps per cycle.
-        const double phase = std::fmod(sample.theta, 4.0 * std::numbers::pi);
-        const bool near_jump = std::abs(phase - 2.0 * std::numbers::pi) < 0.05 ||
-                               std::abs(phase - 3.0 * std::numbers::pi) < 0.05;
-        if (!near_jump)
+        if (!near_force_jump(sample.theta))
           reaction_error = std::max(
               reaction_error, std::abs(engine::bearing_force_z(e, state) - sample.R_z) / peak);
       });
@@ -176,8 +190,7 @@ TEST_CASE("Joint coordinates with generalized-alpha and HHT: the engine, second 
   // The minimal-coordinate solution is the reference; the crank angle after 1 s (about 30
   // turns, 60 switches of the gas force) converges at second order, as in absolute coordinates.
   const auto reference = engine_reference::solve(1.0, 1e-2);
-  double peak = 0.0;
-  for (const auto& sample : reference) peak = std::max(peak, std::abs(sample.R_z));
+  const double peak = peak_bearing_force(reference);
   engine::Engine e = engine::build();
   for (const char* integrator : {"generalized-alpha", "hht"}) {
     std::array<double, 2> theta_error{};
@@ -190,10 +203,7 @@ TEST_CASE("Joint coordinates with generalized-alpha and HHT: the engine, second 
       double reaction_error = 0.0;
       const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& state) {
         const auto& expected = reference.at(sample++);
-        const double phase = std::fmod(expected.theta, 4.0 * std::numbers::pi);
-        const bool near_jump = std::abs(phase - 2.0 * std::numbers::pi) < 0.05 ||
-                               std::abs(phase - 3.0 * std::numbers::pi) < 0.05;
-        if (!near_jump)
+        if (!near_force_jump(expected.theta))
           reaction_error = std::max(
               reaction_error, std::abs(engine::bearing_force_z(e, state) - expected.R_z) / peak);
       });
@@ -220,30 +230,11 @@ TEST_CASE("Joint coordinates with generalized-alpha: a moving chain with springs
           "[joint][large]") {
   // 64 ball-jointed links given 0.1 m/s across, a spring-damper between neighbours' centres,
   // against dop853 at 1e-11 in absolute coordinates (another method and other coordinates).
-  using Model = sp::Model<sp::Spherical, sp::Gravity, sp::Tsda>;
   const int n = 64;
-  Model model;
-  odyn::BodyId previous = odyn::ground;
-  for (int i = 0; i < n; ++i) {
-    sp::Body link{.name = "link" + std::to_string(i),
-                  .mass = 1.0,
-                  .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-                  .position = {0.5 + i, 0.0, 0.0},
-                  .linear_velocity = {0.0, 0.1, 0.0}};
-    link.velocity_given = std::array<bool, 6>{true, true, true, true, true, true};
-    const odyn::BodyId body = model.add_body(link);
-    model.add(sp::Spherical("joint" + std::to_string(i), previous,
-                            previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0), body,
-                            {-0.5, 0.0, 0.0}));
-    if (!previous.is_ground())
-      model.add(sp::Tsda("spring" + std::to_string(i), previous, Vector3d::Zero(), body,
-                         Vector3d::Zero(),
-                         {.stiffness = 40.0, .damping = 0.5, .free_length = 0.9}));
-    previous = body;
-  }
-  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  const RopeModel model =
+      rope(n, 0.1, sp::Tsda::Parameters{.stiffness = 40.0, .damping = 0.5, .free_length = 0.9});
   const auto run = [&](const char* integrator, const char* coordinates, double step) {
-    odyn::Workspace<Model> ws(model);
+    odyn::Workspace<RopeModel> ws(model);
     odyn::DynamicsSettings settings = joint_settings(integrator, 1e-11);
     settings.coordinates = coordinates;
     settings.step = step;
@@ -275,27 +266,11 @@ TEST_CASE("Joint coordinates with generalized-alpha: stiff springs between the l
   // mass over h^2 at h = 1e-3. Newton's matrix in joint coordinates holds each body's own
   // blocks (without them, the first case failed at t = 0.1 s); the blocks that join two links
   // stay out of it, and with ten times the stiffness the run stops with advice.
-  using Model = sp::Model<sp::Spherical, sp::Gravity, sp::Tsda>;
+  using Model = RopeModel;
   const auto chain = [](double stiffness) {
-    Model model;
-    odyn::BodyId previous = odyn::ground;
-    for (int i = 0; i < 20; ++i) {
-      const odyn::BodyId body =
-          model.add_body({.name = "link" + std::to_string(i),
-                          .mass = 1.0,
-                          .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-                          .position = {0.5 + i, 0.0, 0.0}});
-      model.add(sp::Spherical("joint" + std::to_string(i), previous,
-                              previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0), body,
-                              {-0.5, 0.0, 0.0}));
-      if (!previous.is_ground())
-        model.add(sp::Tsda("spring" + std::to_string(i), previous, Vector3d(0, 0.2, 0), body,
-                           Vector3d(0, 0.2, 0),
-                           {.stiffness = stiffness, .damping = 50.0, .free_length = 0.9}));
-      previous = body;
-    }
-    model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
-    return model;
+    return rope(20, 0.0,
+                sp::Tsda::Parameters{.stiffness = stiffness, .damping = 50.0, .free_length = 0.9},
+                0.2);
   };
   const auto run = [](const Model& model, const char* integrator, const char* coordinates) {
     odyn::Workspace<Model> ws(model);
@@ -465,22 +440,9 @@ TEST_CASE("Joint coordinates: a 512-link ball chain against absolute coordinates
   // The scaling report's rope: links of 1 m and 1 kg, horizontal and at rest, released under
   // gravity. 1536 tree coordinates and no closure against 3584 absolute coordinates and 1536
   // constraint equations (the sparse Schur complement), both with dop853 at 1e-10.
-  using Model = sp::Model<sp::Spherical, sp::Gravity>;
+  using Model = RopeModel;
   const int n = 512;
-  Model model;
-  odyn::BodyId previous = odyn::ground;
-  for (int i = 0; i < n; ++i) {
-    const odyn::BodyId body =
-        model.add_body({.name = "link" + std::to_string(i),
-                        .mass = 1.0,
-                        .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-                        .position = {0.5 + i, 0.0, 0.0}});
-    model.add(sp::Spherical("joint" + std::to_string(i), previous,
-                            previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0), body,
-                            {-0.5, 0.0, 0.0}));
-    previous = body;
-  }
-  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  const Model model = rope(n);
   const auto run = [&](const char* coordinates) {
     odyn::Workspace<Model> ws(model);
     odyn::DynamicsSettings settings = joint_settings("dop853", 1e-10);

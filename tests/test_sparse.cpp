@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,12 +20,13 @@
 #include "odyn/linalg/sparse_basis.hpp"
 #include "odyn/linalg/sparse_cholesky.hpp"
 #include "odyn/linalg/sparse_lu.hpp"
+#include "rope_model.hpp"
 
 namespace test_sparse {
 
 namespace sp = odyn::spatial;
 using Eigen::Vector3d;
-using ChainModel = sp::Model<sp::Spherical, sp::Gravity, sp::Tsda>;
+using ChainModel = rope_model::Model;
 
 /// A deterministic number in [-1, 1] (no structure).
 double scrambled(int i, int j, double seed) {
@@ -189,31 +191,13 @@ TEST_CASE("Sparse elimination finds the same dependent vectors as dense ranks", 
   CHECK(dependent > 16);
 }
 
-/// A spherical chain of `links` links of 1 m and 1 kg along x from the origin, a spring-damper
-/// of `stiffness` between neighbours if `springs`, gravity along -z; with a `speed`, every link
-/// is given that velocity along y (the assembly keeps what the joints allow).
+/// The rope (tests/rope_model.hpp), a spring-damper of `stiffness` between neighbours' centres
+/// if `springs`; with a `speed`, every link is given that velocity along y.
 ChainModel chain(int links, bool springs, double stiffness = 40.0, double speed = 0.0) {
-  ChainModel model;
-  odyn::BodyId previous = odyn::ground;
-  for (int i = 0; i < links; ++i) {
-    sp::Body link{.name = "link" + std::to_string(i),
-                  .mass = 1.0,
-                  .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-                  .position = {0.5 + i, 0.0, 0.0},
-                  .linear_velocity = {0.0, speed, 0.0}};
-    if (speed != 0.0) link.velocity_given = std::array<bool, 6>{true, true, true, true, true, true};
-    const odyn::BodyId body = model.add_body(link);
-    const Vector3d on_previous = previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0);
-    model.add(
-        sp::Spherical("ball" + std::to_string(i), previous, on_previous, body, {-0.5, 0.0, 0.0}));
-    if (springs && !previous.is_ground())
-      model.add(sp::Tsda("spring" + std::to_string(i), previous, Vector3d::Zero(), body,
-                         Vector3d::Zero(),
-                         {.stiffness = stiffness, .damping = 0.5, .free_length = 0.9}));
-    previous = body;
-  }
-  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
-  return model;
+  return rope_model::rope(links, speed,
+                          springs ? std::optional(sp::Tsda::Parameters{
+                                        .stiffness = stiffness, .damping = 0.5, .free_length = 0.9})
+                                  : std::nullopt);
 }
 
 /// Every factorization's solve of the Newton matrix at the assembled state, against the dense
