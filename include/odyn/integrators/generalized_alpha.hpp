@@ -12,9 +12,10 @@
 // What it steps is a template parameter (analysis/absolute_coordinates.hpp): the bodies' own
 // coordinates (GeneralizedAlpha), or a spanning tree's joint coordinates with the loop
 // closures as constraints (JointGeneralizedAlpha), where q, v and v' are joint coordinates,
-// rates and their rates, and the Newton matrix holds the mass matrix in joint coordinates,
-// factorized by the articulated-body algorithm (the forces' stiffness and damping and the
-// velocity terms' derivatives stay out of it there: a modified Newton iteration).
+// rates and their rates, and the Newton matrix holds the mass matrix in joint coordinates with
+// each body's own spring and damper blocks, factorized by the articulated-body algorithm (the
+// blocks that join two bodies and the tree's velocity terms' derivatives stay out of it there:
+// a modified Newton iteration).
 
 #include <Eigen/Core>
 #include <algorithm>
