@@ -103,8 +103,8 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
       for (double tol : tight) ladder.push_back({name, name, true, tol});
   if (joint_coordinates) {  // the same methods on a spanning tree's joint coordinates
     for (double h : steps)
-      ladder.push_back({"generalized-alpha, fixed h, joint coordinates", "generalized-alpha",
-                        false, h, 0.9, 6, "joint"});
+      ladder.push_back({"generalized-alpha, fixed h, joint coordinates", "generalized-alpha", false,
+                        h, 0.9, 6, "joint"});
     for (const std::string name : {"dopri5", "dop853"})
       for (double tol : tight)
         ladder.push_back({name + ", joint coordinates", name, true, tol, 0.9, 6, "joint"});
