@@ -13,6 +13,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine_model.hpp"
@@ -382,6 +383,62 @@ TEST_CASE("A large model's redundant joint is named, and the model still runs", 
   // joint keeps the last two together.
   CHECK(std::abs(ws.q[99 * 7 + 2] - (-0.5 * 9.81 * 0.01 * 0.01)) <= 1e-6);
   CHECK(ws.phi.cwiseAbs().maxCoeff() <= 1e-10);
+}
+
+TEST_CASE("Runs after the first start from its checked assembled state", "[sparse][assembly]") {
+  // A moving rope (every velocity component given, the assembly keeping what the joints
+  // allow), small (dense assembly) and large (sparse), and a large one falling from rest (its
+  // Phi_q v' is zero: the check must not take rounding there for a change). The reference for
+  // a run that reuses the kept state is the same run assembled from scratch.
+  for (const auto& [links, speed] : {std::pair{6, 0.1}, std::pair{120, 0.1}, std::pair{120, 0.0}}) {
+    CAPTURE(links, speed);
+    const ChainModel model = rope_model::rope(links, speed);
+    odyn::DynamicsSettings s;
+    s.t_end = 0.02;
+    s.step = 1e-3;
+    s.output_interval = 0.01;
+    const auto ignore = [](const auto&) {};
+    odyn::AssembledStart<ChainModel> start;
+    odyn::Workspace<ChainModel> plain(model), first(model), second(model);
+    const odyn::RunSummary reference = odyn::simulate(model, plain, s, ignore);
+    const odyn::RunSummary filled = odyn::simulate(model, first, s, ignore, &start);
+    REQUIRE(start.state.has_value());
+    const odyn::RunSummary reused = odyn::simulate(model, second, s, ignore, &start);
+    CHECK_FALSE(reference.assembly_reused);
+    CHECK_FALSE(filled.assembly_reused);
+    CHECK(reused.assembly_reused);
+    // The same start and the same arithmetic: the same run, to the bit.
+    CHECK(second.q == plain.q);
+    CHECK(second.lambda == plain.lambda);
+    CHECK(reused.assembly.kept_velocity_components == reference.assembly.kept_velocity_components);
+    CHECK(reused.statistics.newton_iterations == reference.statistics.newton_iterations);
+
+    // Other assembly settings: assembled afresh (and kept in place of the first).
+    odyn::DynamicsSettings klu = s;
+    klu.linear_solver = odyn::LinearSolver::klu;
+    odyn::Workspace<ChainModel> third(model);
+    CHECK_FALSE(odyn::simulate(model, third, klu, ignore, &start).assembly_reused);
+    CHECK(start.settings.linear_solver == odyn::LinearSolver::klu);
+
+    // What the check finds in a kept state that no longer fits.
+    const odyn::AssemblySettings& settings = start.settings;
+    odyn::Workspace<ChainModel> kept = *start.state;
+    REQUIRE(odyn::check_assembled(model, kept, settings, start.report) ==
+            odyn::AssembledCheck::assembled);
+    kept.vdot[2] += 1e-3;  // as after a change of the forces: solve the accelerations again
+    CHECK(odyn::check_assembled(model, kept, settings, start.report) ==
+          odyn::AssembledCheck::forces_changed);
+    odyn::assemble_accelerations(model, kept, settings);
+    CHECK((kept.vdot - start.state->vdot).cwiseAbs().maxCoeff() <=
+          1e-12 * start.state->vdot.cwiseAbs().maxCoeff());
+    kept.v[1] += 1e-3;  // off the velocity constraints
+    CHECK(odyn::check_assembled(model, kept, settings, start.report) ==
+          odyn::AssembledCheck::not_assembled);
+    kept = *start.state;
+    kept.q[0] += 1e-9;  // off the position constraints
+    CHECK(odyn::check_assembled(model, kept, settings, start.report) ==
+          odyn::AssembledCheck::not_assembled);
+  }
 }
 
 TEST_CASE("A hanging chain on the sparse path swings at its analytic frequencies",

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -57,6 +58,7 @@ struct DynamicsSettings {
 struct RunSummary {
   IntegratorStatistics statistics;
   AssemblyReport assembly;
+  bool assembly_reused = false;  // started from an AssembledStart's state, not assembled again
   long outputs = 0;
   double wall_seconds = 0.0;           // the whole run
   double setup_seconds = 0.0;          // of which assembly and the integrator's setup
@@ -66,6 +68,32 @@ struct RunSummary {
   /// run goes on with the minimum-norm multipliers, and the reactions of these joints are then
   /// one choice among many (see analysis/saddle_point.hpp). Empty for an ordinary mechanism.
   std::vector<RedundantEquation> redundant_equations;
+};
+
+/// An assembled initial state kept to start runs from, so that the setup runs once for several
+/// runs of one model (Python keeps one per model until the model changes). simulate() fills an
+/// empty one when it assembles; given a filled one, it starts from that state instead of
+/// assembling again, if the settings' assembly settings are the same and the state still is
+/// assembled (see is_assembled): else it assembles afresh. Accelerations and multipliers that no
+/// longer solve the equations of motion (a Python force that changed) are solved again.
+template <class Model>
+struct AssembledStart {
+  std::optional<Workspace<Model>> state;  // right after the assembly
+  AssemblyReport report;
+  std::vector<RedundantEquation> redundant_equations;
+  AssemblySettings settings;  // those it was assembled with
+
+  bool matches(const AssemblySettings& s) const {
+    return state && s.tolerance == settings.tolerance &&
+           s.max_iterations == settings.max_iterations && s.linear_solver == settings.linear_solver;
+  }
+  void keep(const Workspace<Model>& ws, const AssemblyReport& assembly,
+            std::vector<RedundantEquation> redundant, const AssemblySettings& s) {
+    state = ws;
+    report = assembly;
+    redundant_equations = std::move(redundant);
+    settings = s;
+  }
 };
 
 /// Norms of the position and velocity constraint residuals at the workspace's last evaluation.
@@ -325,11 +353,12 @@ inline const std::vector<std::pair<std::string, std::string>>& integrator_names(
 }
 
 /// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
-/// instantiated), from the workspace's state (assembled first). `observe(ws)` sees the
-/// workspace at t0 and at every output time, with frames and element blocks up to date.
+/// instantiated), from the workspace's state (assembled first, or taken from `start`, see
+/// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
+/// and element blocks up to date.
 template <template <class> class IntegratorType, class Model, class Observer>
 RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe) {
+                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
   if (!(s.step > 0.0) || !(s.output_interval > 0.0) || !(s.t_end >= ws.t))
     throw ModelError("dynamics",
                      "step and output interval must be positive and t_end >= t0 "
@@ -341,16 +370,30 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
                                      ", atol " + to_text(s.atol) + ")");
   using Integrator = IntegratorType<Model>;
   static_assert(StepIntegrator<Integrator>);
-  const auto start = std::chrono::steady_clock::now();
+  const auto started = std::chrono::steady_clock::now();
   RunSummary summary;
   AssemblySettings assembly = s.assembly;
   assembly.linear_solver = s.linear_solver;
-  summary.assembly = assemble(model, ws, assembly);
-  summary.redundant_equations = redundant_equations(model, ws);
+  if (start != nullptr && start->matches(assembly)) {
+    Workspace<Model> kept = *start->state;
+    const AssembledCheck check = check_assembled(model, kept, assembly, start->report);
+    if (check == AssembledCheck::forces_changed) assemble_accelerations(model, kept, assembly);
+    if (check != AssembledCheck::not_assembled) {
+      ws = std::move(kept);
+      summary.assembly = start->report;
+      summary.redundant_equations = start->redundant_equations;
+      summary.assembly_reused = true;
+    }
+  }
+  if (!summary.assembly_reused) {
+    summary.assembly = assemble(model, ws, assembly);
+    summary.redundant_equations = redundant_equations(model, ws);
+    if (start != nullptr) start->keep(ws, summary.assembly, summary.redundant_equations, assembly);
+  }
   Integrator integrator(model, ws, detail::integrator_settings<typename Integrator::Settings>(s),
                         detail::step_control(s));
   summary.setup_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   auto record = [&] {
     if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
@@ -375,22 +418,25 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   }
   summary.statistics = integrator.statistics();
   summary.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
 }
 
 /// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()).
+/// With `start`, runs after the first start from its assembled state (see AssembledStart).
 template <class Model, class Observer>
 RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                    Observer&& observe) {
+                    Observer&& observe, AssembledStart<Model>* start = nullptr) {
   if (s.coordinates == "joint") {
     if constexpr (std::is_same_v<typename Model::Space, Spatial>) {
-      if (s.integrator == "dopri5") return simulate_with<JointDormandPrince>(model, ws, s, observe);
+      if (s.integrator == "dopri5")
+        return simulate_with<JointDormandPrince>(model, ws, s, observe, start);
       if (s.integrator == "dop853")
-        return simulate_with<JointDormandPrince853>(model, ws, s, observe);
-      if (s.integrator == "adams") return simulate_with<JointAdamsBashforth>(model, ws, s, observe);
+        return simulate_with<JointDormandPrince853>(model, ws, s, observe, start);
+      if (s.integrator == "adams")
+        return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start);
       if (s.integrator == "generalized-alpha" || s.integrator == "hht")
-        return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe);
+        return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
       throw ModelError("dynamics",
                        "joint coordinates run with generalized-alpha, hht, dopri5, dop853 or "
                        "adams, not '" +
@@ -407,11 +453,12 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
                      "unknown coordinates '" + s.coordinates + "'; choose 'absolute' or 'joint'");
   }
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
-    return simulate_with<GeneralizedAlpha>(model, ws, s, observe);
-  if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe);
-  if (s.integrator == "dop853") return simulate_with<DormandPrince853>(model, ws, s, observe);
-  if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe);
-  if (s.integrator == "adams") return simulate_with<AdamsBashforth>(model, ws, s, observe);
+    return simulate_with<GeneralizedAlpha>(model, ws, s, observe, start);
+  if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe, start);
+  if (s.integrator == "dop853")
+    return simulate_with<DormandPrince853>(model, ws, s, observe, start);
+  if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe, start);
+  if (s.integrator == "adams") return simulate_with<AdamsBashforth>(model, ws, s, observe, start);
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
   throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);

@@ -7,8 +7,10 @@ floats, dicts) or raise `SceneError` naming the place (``joints[2].axis``) and w
 
 from __future__ import annotations
 
+import itertools
 import math
-from typing import Any, Callable, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple
+from typing import (Any, Callable, Collection, Dict, List, Mapping, NoReturn, Optional, Sequence,
+                    Tuple)
 
 from . import _core
 
@@ -166,10 +168,22 @@ def check_motion(x: Any, where: str) -> Dict[str, Any]:
 # --- Parameter kinds ----------------------------------------------------------------------------
 # Each kind checks one value: (value, where, model) -> normalized value. `model` resolves bodies.
 
+class Names:
+    """The names in use in a model, from several mappings or sets (bodies, elements): tests
+    membership in constant time."""
+
+    def __init__(self, *groups: Collection[str]) -> None:
+        self._groups = groups
+
+    def __contains__(self, name: object) -> bool:
+        return any(name in group for group in self._groups)
+
+
 def _body(x, where, bodies):
     name = check_name(x, where)
     if name not in bodies:
-        known = ", ".join(bodies) if len(bodies) <= 12 else ", ".join(bodies[:12]) + ", ..."
+        first = list(itertools.islice(bodies, 13))
+        known = ", ".join(first[:12]) + (", ..." if len(first) > 12 else "")
         fail(where, f"no body named '{name}'; the model has: {known}")
     return name
 
@@ -301,7 +315,7 @@ DRIVEN_JOINTS = {"revolute_driver": ("revolute",),
                  "translational_driver": ("translational", "cylindrical")}
 
 
-def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: List[str],
+def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Collection[str],
                   elements: Mapping[str, Tuple[str, Dict[str, Any]]],
                   space: str = "spatial") -> Dict[str, Any]:
     """Normalized parameters of an element of type `kind` in `space`; `elements`: name ->

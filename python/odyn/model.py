@@ -80,16 +80,22 @@ class BaseModel:
     def __init__(self) -> None:
         self._core: Any = _core.PlanarModel() if self.space == "planar" else _core.Model()
         self._bodies: List[Dict[str, Any]] = []
+        # name -> index in body_names ("ground" is 0): lookups in constant time, so that a
+        # model of many thousands of bodies is built in time linear in its size.
+        self._body_index: Dict[str, int] = {"ground": 0}
         # name -> (type, normalized parameters, parameters as given): the scene description.
         self._elements: Dict[str, Tuple[str, Dict[str, Any], Dict[str, Any]]] = {}
+        # name -> (type, normalized parameters): what check_element resolves drivers against.
+        self._checked: Dict[str, Tuple[str, Dict[str, Any]]] = {}
 
     def _add_body(self, params: Mapping[str, Any], where: str) -> str:
-        body = _schema.check_body(params, where, self.body_names + list(self._elements),
+        body = _schema.check_body(params, where, _schema.Names(self._body_index, self._elements),
                                   self.space)
         try:
             self._core.add_body(body)
         except _core.ModelError as e:
             raise SceneError(f"{where}: {e}") from None
+        self._body_index[body["name"]] = len(self._body_index)
         self._bodies.append(body)
         return body["name"]
 
@@ -111,21 +117,21 @@ class BaseModel:
                     if kind in _schema.CATALOGUE[other] else "")
             _schema.fail(where, f"unknown {self.space} element type '{kind}'{hint}; expected "
                          "one of " + ", ".join(catalogue))
-        checked = _schema.check_element(kind, params, where, self.body_names,
-                                        {n: (t, p) for n, (t, p, _) in self._elements.items()},
+        checked = _schema.check_element(kind, params, where, self._body_index, self._checked,
                                         self.space)
         try:
             self._core.add_element(kind, checked)
         except _core.ModelError as e:
             raise SceneError(f"{where}: {e}") from None
         self._elements[checked["name"]] = (kind, checked, dict(params))
+        self._checked[checked["name"]] = (kind, checked)
         return checked["name"]
 
     # --- what is in it ----------------------------------------------------------------------
     @property
     def body_names(self) -> List[str]:
         """"ground" and the moving bodies, in the order they were added."""
-        return ["ground"] + [b["name"] for b in self._bodies]
+        return list(self._body_index)
 
     @property
     def element_names(self) -> List[str]:
@@ -142,9 +148,9 @@ class BaseModel:
         return dict(self._elements[name][1])
 
     def body(self, name: str) -> Dict[str, Any]:
-        for b in self._bodies:
-            if b["name"] == name:
-                return dict(b)
+        index = self._body_index.get(name, 0)
+        if index > 0:
+            return dict(self._bodies[index - 1])
         raise SceneError(f"{name}: no body of that name in the model")
 
     @property

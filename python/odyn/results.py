@@ -58,7 +58,7 @@ class Statistics(NamedTuple):
     max_error_estimate: float   # largest local error estimate of a step, in units of rtol/atol
     outputs: int
     wall_seconds: float         # the whole run
-    setup_seconds: float        # of which assembly and the integrator's setup
+    setup_seconds: float        # of which assembly (unless reused) and the integrator's setup
     max_position_residual: float  # max |Phi| at the output times
     max_velocity_residual: float  # max |Phi_q v + Phi_t| at the output times
 
@@ -268,7 +268,9 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
              linear_solver: str = "auto") -> Result:
     """Consistent initial positions, velocities, accelerations and multipliers (one row).
     Redundant constraint equations are listed in `result.redundant_equations` and give a
-    `RedundantConstraintsWarning`. linear_solver: as in `simulate`."""
+    `RedundantConstraintsWarning`. linear_solver: as in `simulate`. The model keeps the
+    assembled state until it changes: `simulate` with the same assembly settings starts from
+    it instead of assembling again."""
     data = _core.assemble(model._core, {
         "assembly_tolerance": tolerance, "assembly_max_iterations": max_iterations,
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
@@ -290,6 +292,12 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
              order: Optional[int] = None, coordinates: str = "absolute",
              linear_solver: str = "auto") -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
+
+    The assembly runs once per model: a later `simulate` (or one after `assemble`) of the
+    unchanged model starts from the state the first one assembled, checked against the
+    constraints and the equations of motion (accelerations are solved again if a Python force
+    changed); `summary["assembly"]["reused"]` says which happened, and `setup_seconds` then
+    counts the integrator's setup only.
 
     integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
     rho_inf) or "hht" take fixed steps of at most `step` (a step whose Newton iteration fails

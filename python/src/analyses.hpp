@@ -247,6 +247,7 @@ inline py::dict run_summary(const RunSummary& s) {
   d["max_velocity_residual"] = s.max_velocity_residual;
   py::dict assembly = assembly_report(s.assembly);
   assembly["redundant_equations"] = redundant_list(s.redundant_equations);
+  assembly["reused"] = s.assembly_reused;
   d["assembly"] = assembly;
   return d;
 }
@@ -307,6 +308,7 @@ py::dict assemble(Box& box, const py::dict& settings) {
     box.monitor->start();
     report = odyn::assemble(box.model, ws, s);
     redundant = odyn::redundant_equations(box.model, ws);
+    box.assembled.keep(ws, report, redundant, s);
     recorder.record(ws);
   }
   py::dict out = recorder.to_python();
@@ -332,7 +334,7 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
     using Clock = std::chrono::steady_clock;
     auto last_report = Clock::now();
     try {
-      summary = odyn::simulate(box.model, ws, s, [&](const odyn::Workspace<M>& state) {
+      const auto record = [&](const odyn::Workspace<M>& state) {
         recorder.record(state);
         py::gil_scoped_acquire gil;
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C, say
@@ -342,7 +344,8 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
           progress(state.t);
           last_report = Clock::now();
         }
-      });
+      };
+      summary = odyn::simulate(box.model, ws, s, record, &box.assembled);
     } catch (...) {
       error = std::current_exception();
     }

@@ -265,6 +265,9 @@ struct ModelBox {
   std::shared_ptr<RunMonitor> monitor = std::make_shared<RunMonitor>();
   M model;
   bool running = false;
+  /// The last assembly's state, until the model changes: runs start from it (see
+  /// AssembledStart), so that `simulate` after `assemble` does not assemble again.
+  AssembledStart<M> assembled;
 };
 using SpatialBox = ModelBox<Model>;
 using PlanarBox = ModelBox<PlanarModel>;

@@ -249,6 +249,7 @@ std::function<Vector(double, const Spatial::Frame&)> frame_function(py::object f
 
 void add_element(SpatialBox& box, const std::string& type, const py::dict& d) {
   if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
+  box.assembled = {};  // the model changes: assemble again
   Model& model = box.model;
   const std::string name = text(d, "name");
   const std::string what = describe(type, name);
@@ -339,6 +340,7 @@ void add_body(SpatialBox& box, const py::dict& d) {
   body.angular_velocity = vec3(d, "angular_velocity");
   if (d.contains("velocity_given") && !d["velocity_given"].is_none())
     body.velocity_given = d["velocity_given"].cast<std::array<bool, 6>>();
+  box.assembled = {};  // the model changes: assemble again
   box.model.add_body(std::move(body));
 }
 

@@ -68,11 +68,13 @@ void add_planar_body(PlanarBox& box, const py::dict& d) {
   body.angular_velocity = number(d, "angular_velocity");
   if (d.contains("velocity_given") && !d["velocity_given"].is_none())
     body.velocity_given = d["velocity_given"].cast<std::array<bool, 3>>();
+  box.assembled = {};  // the model changes: assemble again
   box.model.add_body(std::move(body));
 }
 
 void add_planar_element(PlanarBox& box, const std::string& type, const py::dict& d) {
   if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
+  box.assembled = {};  // the model changes: assemble again
   PlanarModel& model = box.model;
   const std::string name = text(d, "name");
   const std::string what = type + " '" + name + "'";

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "odyn/analysis/sparse_assembly.hpp"
@@ -150,6 +151,27 @@ Eigen::VectorXd sparse_position_step(const Model& model, const Workspace<Model>&
   return step;
 }
 
+/// Accelerations and multipliers from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] on sparse
+/// rows (`use`: the independent ones), with the workspace's forces and gamma evaluated. A
+/// constraint row that repeats earlier ones gets no multiplier (0).
+template <class Model>
+void solve_accelerations_sparse(const Model& model, Workspace<Model>& ws, const SparseRows& rows,
+                                const std::vector<char>& use) {
+  constexpr int nv = Model::nv;
+  const int m = model.num_equations();
+  Eigen::VectorXd g(std::count(use.begin(), use.end(), 1));
+  for (int r = 0, k = 0; r < m; ++r)
+    if (use[r]) g[k++] = ws.gamma[r];
+  Eigen::VectorXd vdot, multipliers;
+  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), rows, use, {}, ws.force, g, vdot,
+                                     multipliers))
+    throw AssemblyError("assembly", "the mass-constraint matrix is singular (sparse assembly)");
+  ws.vdot = vdot;
+  ws.lambda.setZero();
+  for (int r = 0, k = 0; r < m; ++r)
+    if (use[r]) ws.lambda[r] = multipliers[k++];
+}
+
 /// Velocities (keeping the given components that the constraints leave free, the rest
 /// changed as little as possible in the kinetic-energy metric), then accelerations and
 /// multipliers, on sparse rows. A constraint row that repeats earlier ones gets no multiplier
@@ -195,17 +217,7 @@ void assemble_velocities_and_accelerations_sparse(const Model& model, Workspace<
   initialize_states(model, ws);
   evaluate_forces(model, ws);
   evaluate_gamma(model, ws);
-  g.resize(independent);
-  for (int r = 0, k = 0; r < m; ++r)
-    if (use[r]) g[k++] = ws.gamma[r];
-  Eigen::VectorXd vdot;
-  if (!solve_sparse_saddle_point<nv>(mass_blocks(model), rows, use, {}, ws.force, g, vdot,
-                                     multipliers))
-    throw AssemblyError("assembly", "the mass-constraint matrix is singular (sparse assembly)");
-  ws.vdot = vdot;
-  ws.lambda.setZero();
-  for (int r = 0, k = 0; r < m; ++r)
-    if (use[r]) ws.lambda[r] = multipliers[k++];
+  solve_accelerations_sparse(model, ws, rows, use);
 }
 
 /// Minimum-norm solution of the saddle-point system [A C^T; C 0] [x; y] = [f; g].
@@ -222,6 +234,17 @@ inline void solve_saddle_point(const Eigen::MatrixXd& a, const Eigen::MatrixXd& 
   const Eigen::VectorXd solution = RankRevealingQr(kkt, 1e-12).solve(rhs);
   x = solution.head(n);
   y = solution.tail(m);
+}
+
+/// Accelerations and multipliers, minimum-norm, from the dense mass matrix and Jacobian, with
+/// the workspace's forces and gamma evaluated.
+template <class Model>
+void solve_accelerations_dense(const Eigen::MatrixXd& mass, const Eigen::MatrixXd& jacobian,
+                               Workspace<Model>& ws) {
+  Eigen::VectorXd vdot, lambda;
+  solve_saddle_point(mass, jacobian, ws.force, ws.gamma, vdot, lambda);
+  ws.vdot = vdot;
+  ws.lambda = lambda;
 }
 }  // namespace detail
 
@@ -351,11 +374,77 @@ AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const Assembly
   initialize_states(model, ws);
   evaluate_forces(model, ws);
   evaluate_gamma(model, ws);
-  Eigen::VectorXd vdot, lambda;
-  detail::solve_saddle_point(mass, jacobian, ws.force, ws.gamma, vdot, lambda);
-  ws.vdot = vdot;
-  ws.lambda = lambda;
+  detail::solve_accelerations_dense(mass, jacobian, ws);
   return report;
+}
+
+/// Accelerations and multipliers at the workspace's positions and velocities (the last stage of
+/// assemble), for a state whose forces changed since it was assembled. Stateful force elements
+/// keep their states.
+template <class Model>
+void assemble_accelerations(const Model& model, Workspace<Model>& ws,
+                            const AssemblySettings& s = {}) {
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  evaluate_forces(model, ws);
+  evaluate_gamma(model, ws);
+  if (detail::sparse_assembly(model, s)) {
+    const detail::SparseRows rows = detail::sparse_jacobian(model, ws);
+    detail::solve_accelerations_sparse(model, ws, rows,
+                                       detail::independent_rows(rows, rank_tolerance));
+  } else {
+    detail::solve_accelerations_dense(detail::dense_mass(model), detail::dense_jacobian(model, ws),
+                                      ws);
+  }
+}
+
+/// What check_assembled finds in a workspace that an assembly filled earlier.
+enum class AssembledCheck {
+  assembled,       // as an assembly leaves it
+  forces_changed,  // positions and velocities are, accelerations and multipliers no longer fit
+  not_assembled,   // positions or velocities off the constraints (a driver changed, say)
+};
+
+/// Whether the workspace holds an assembled state at its time: positions and velocities on the
+/// constraints (|Phi| within the tolerance, the velocity residual no larger than `report`
+/// found, up to rounding), and accelerations and multipliers that solve the equations of motion
+/// there to rounding. Leaves the constraints, forces and gamma evaluated at that state.
+template <class Model>
+AssembledCheck check_assembled(const Model& model, Workspace<Model>& ws, const AssemblySettings& s,
+                               const AssemblyReport& report) {
+  update_frames(model, ws);
+  evaluate_constraints(model, ws);
+  const auto largest = [](const Eigen::VectorXd& x) {
+    return x.size() > 0 ? x.cwiseAbs().maxCoeff() : 0.0;
+  };
+  if (!(largest(ws.phi) <= s.tolerance)) return AssembledCheck::not_assembled;
+  const int n = model.num_velocities(), m = model.num_equations();
+  Eigen::VectorXd constraint_rate(m);
+  jacobian_times(model, ws, ws.v, constraint_rate);
+  // (2x: the report's residual may have been summed in another order.)
+  if (!(largest(constraint_rate + ws.phi_t) <= 2.0 * report.velocity_residual + s.tolerance))
+    return AssembledCheck::not_assembled;
+  evaluate_forces(model, ws);
+  evaluate_gamma(model, ws);
+  // M v' + Phi_q^T lambda = Q and Phi_q v' = gamma, to rounding relative to their terms (the
+  // terms of Phi_q v' summed in absolute value: it is zero on a chain falling freely).
+  constexpr double relative = 1e-9;
+  Eigen::VectorXd inertia(n), reaction = Eigen::VectorXd::Zero(n), constraint_acceleration(m);
+  mass_times(model, ws.vdot, inertia);
+  add_jacobian_transpose_times(model, ws, ws.lambda, reaction);
+  jacobian_times(model, ws, ws.vdot, constraint_acceleration);
+  Eigen::VectorXd acceleration_terms = Eigen::VectorXd::Zero(m);
+  detail::for_each_jacobian_block(model, ws, [&](int row, int column, const auto& block) {
+    constexpr int rows = std::decay_t<decltype(block)>::RowsAtCompileTime;
+    acceleration_terms.template segment<rows>(row).noalias() +=
+        block.cwiseAbs() * ws.vdot.template segment<Model::nv>(column).cwiseAbs();
+  });
+  const double force_scale =
+      std::max({largest(inertia), largest(reaction), largest(ws.force), 1e-300});
+  const double rate_scale = std::max({largest(acceleration_terms), largest(ws.gamma), 1e-300});
+  const bool balanced = largest(inertia + reaction - ws.force) <= relative * force_scale &&
+                        largest(constraint_acceleration - ws.gamma) <= relative * rate_scale;
+  return balanced ? AssembledCheck::assembled : AssembledCheck::forces_changed;
 }
 
 /// The constraint equations that repeat what others impose at the workspace's pose (empty when
