@@ -16,7 +16,9 @@
 //   revolute-chain           hinges about y instead of balls;
 //   binary-tree              a ball-jointed binary tree of links, breadth first;
 //   four-bar-ladder          a column of four-bar loops (a bar hung on two ball-jointed
-//                            links per cell), N / 3 closed loops.
+//                            links per cell), N / 3 closed loops;
+//   four-bar-ladder-hinged   the loops on parallel hinges instead, in the plane of gravity:
+//                            3 redundant equations per loop (N in all).
 // The same models in joint coordinates (analysis/joint_coordinates.hpp), named with "-joint":
 // spherical-chain-joint, revolute-chain-joint, binary-tree-joint and four-bar-ladder-joint (to
 // N = 256: its N / 3 loops make each evaluation O(N^2)). There step_s is one forward-dynamics
@@ -135,7 +137,10 @@ Model binary_tree(int n) {
 /// equations (four parallel hinges would repeat three equations a loop, and a planar hinge
 /// four-bar in this pose is at a singular point). Each cell swings in and out of its plane and
 /// its parts spin about their own axes. 3 bodies a cell.
-Model four_bar_ladder(int n) {
+/// With `hinged`, the loops lie in the x-y plane on hinges about z, under gravity along -y: a
+/// parallelogram of four parallel hinges repeats 3 of its 20 equations, so the model is
+/// over-constrained by N equations (the sparse Schur path pins them, see saddle_point.hpp).
+Model four_bar_ladder(int n, bool hinged = false) {
   Model model;
   odyn::BodyId previous = odyn::ground;
   int index = 0;
@@ -148,15 +153,21 @@ Model four_bar_ladder(int n) {
     const odyn::BodyId across = model.add_body(bar);
     const std::string c = std::to_string(cell);
     // The previous bar's ends (or the ground's points) at y = -0.5 and 0.5.
-    add_joint(model, Joint::ball, "left-bottom" + c, previous, {0.0, -0.5, 0.0}, left,
-              {-0.5, 0.0, 0.0});
-    add_joint(model, Joint::ball, "left-top" + c, left, {0.5, 0.0, 0.0}, across, {0.0, -0.5, 0.0});
-    add_joint(model, Joint::ball, "right-bottom" + c, previous, {0.0, 0.5, 0.0}, right,
-              {-0.5, 0.0, 0.0});
-    add_joint(model, Joint::ball, "right-top" + c, right, {0.5, 0.0, 0.0}, across, {0.0, 0.5, 0.0});
+    const auto joint = [&](const std::string& name, odyn::BodyId a, const Vector3d& on_a,
+                           odyn::BodyId b, const Vector3d& on_b) {
+      if (hinged)
+        model.add(sp::Revolute(name, a, sp::JointFrame{on_a, Vector3d::UnitZ()}, b,
+                               sp::JointFrame{on_b, Vector3d::UnitZ()}));
+      else
+        add_joint(model, Joint::ball, name, a, on_a, b, on_b);
+    };
+    joint("left-bottom" + c, previous, {0.0, -0.5, 0.0}, left, {-0.5, 0.0, 0.0});
+    joint("left-top" + c, left, {0.5, 0.0, 0.0}, across, {0.0, -0.5, 0.0});
+    joint("right-bottom" + c, previous, {0.0, 0.5, 0.0}, right, {-0.5, 0.0, 0.0});
+    joint("right-top" + c, right, {0.5, 0.0, 0.0}, across, {0.0, 0.5, 0.0});
     previous = across;
   }
-  model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
+  model.add(sp::Gravity("gravity", hinged ? Vector3d(0.0, -9.81, 0.0) : Vector3d(0.0, 0.0, -9.81)));
   return model;
 }
 
@@ -293,6 +304,7 @@ int main(int argc, char** argv) {
       {"revolute-chain", [](int n) { return chain(n, Joint::hinge, false); }},
       {"binary-tree", [](int n) { return binary_tree(n); }},
       {"four-bar-ladder", [](int n) { return four_bar_ladder(n); }},
+      {"four-bar-ladder-hinged", [](int n) { return four_bar_ladder(n, true); }},
       {"spherical-chain-joint", [](int n) { return chain(n, Joint::ball, false); }},
       {"revolute-chain-joint", [](int n) { return chain(n, Joint::hinge, false); }},
       {"binary-tree-joint", [](int n) { return binary_tree(n); }},

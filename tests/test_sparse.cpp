@@ -441,6 +441,139 @@ TEST_CASE("Runs after the first start from its checked assembled state", "[spars
   }
 }
 
+/// A column of `cells` parallelograms in the x-y plane, hanging from the ground under gravity
+/// along -y: in each, two links along x (1 m, 1 kg) hinged about z between the previous bar (or
+/// the ground) and a bar along y. Every loop of four parallel hinges repeats 3 equations (20
+/// equations on 18 coordinates, mobility 1).
+using HingedModel = sp::Model<sp::Revolute, sp::Gravity>;
+HingedModel hinged_ladder(int cells) {
+  HingedModel model;
+  const auto hinge = [&](const std::string& name, odyn::BodyId a, const Vector3d& on_a,
+                         odyn::BodyId b, const Vector3d& on_b) {
+    model.add(sp::Revolute(name, a, sp::JointFrame{on_a, Vector3d::UnitZ()}, b,
+                           sp::JointFrame{on_b, Vector3d::UnitZ()}));
+  };
+  odyn::BodyId previous = odyn::ground;
+  for (int cell = 0; cell < cells; ++cell) {
+    const std::string c = std::to_string(cell);
+    const auto link = [&](const std::string& name, const Vector3d& centre,
+                          const Vector3d& inertia) {
+      return model.add_body(
+          sp::Body{.name = name + c,
+                   .mass = 1.0,
+                   .inertia = sp::Body::principal(inertia[0], inertia[1], inertia[2]),
+                   .position = centre});
+    };
+    const Vector3d along_x(5e-5, 1.0 / 12.0, 1.0 / 12.0), along_y(1.0 / 12.0, 5e-3, 1.0 / 12.0);
+    const odyn::BodyId left = link("left", {cell + 0.5, -0.5, 0.0}, along_x);
+    const odyn::BodyId right = link("right", {cell + 0.5, 0.5, 0.0}, along_x);
+    const odyn::BodyId bar = link("bar", {cell + 1.0, 0.0, 0.0}, along_y);
+    hinge("left-bottom" + c, previous, {0.0, -0.5, 0.0}, left, {-0.5, 0.0, 0.0});
+    hinge("left-top" + c, left, {0.5, 0.0, 0.0}, bar, {0.0, -0.5, 0.0});
+    hinge("right-bottom" + c, previous, {0.0, 0.5, 0.0}, right, {-0.5, 0.0, 0.0});
+    hinge("right-top" + c, right, {0.5, 0.0, 0.0}, bar, {0.0, 0.5, 0.0});
+    previous = bar;
+  }
+  model.add(sp::Gravity("gravity", {0.0, -9.81, 0.0}));
+  return model;
+}
+
+TEST_CASE("A large over-constrained model stays on the sparse path", "[sparse][redundant]") {
+  // 10 parallelograms: 30 bodies, 200 equations of which 30 repeat others (past the dense
+  // Schur complement's 120 equations). The reference is
+  // the dense solvers' minimum-norm path on the same model; the pinned rows' multipliers
+  // differ from it, the constraint forces B^T lambda and the motion do not.
+  const HingedModel model = hinged_ladder(10);
+  odyn::Workspace<HingedModel> ws(model);
+  odyn::assemble(model, ws);
+  REQUIRE(odyn::redundant_equations(model, ws).size() == 30);
+  const Eigen::Index n = model.num_velocities(), m = model.num_equations();
+  SECTION("one factorization against the dense minimum-norm solve") {
+    for (const auto& [choice, path] : {std::pair{odyn::LinearSolver::automatic, "cholmod-schur"},
+                                       std::pair{odyn::LinearSolver::klu, "klu"}})
+      for (const odyn::IterationFactors factors :
+           {odyn::IterationFactors{}, odyn::IterationFactors{1.0, 2.5e-5, 0.0}}) {
+        INFO(path << ", stiffness factor " << factors.stiffness);
+        odyn::BlockSchurSaddlePoint<HingedModel> pinned, dense;
+        pinned.choose(choice);
+        dense.choose(odyn::LinearSolver::dense);
+        pinned.analyze(model);
+        dense.analyze(model);
+        CHECK(std::string(pinned.path_name()) == path);
+        REQUIRE(pinned.factorize(model, ws, factors));
+        // Again: now the rows pinned before are looked for first.
+        REQUIRE(pinned.factorize(model, ws, factors));
+        REQUIRE(dense.factorize(model, ws, factors));
+        CHECK(pinned.multipliers_pinned());
+        CHECK(pinned.rank_deficiency() == 30);
+        CHECK(dense.rank_deficiency() == 30);
+        CHECK_FALSE(odyn::needs_minimum_norm_multipliers(pinned));
+        CHECK(odyn::needs_minimum_norm_multipliers(dense));
+        // A consistent right-hand side: g = B x0 for some x0.
+        Eigen::VectorXd x0 = Eigen::VectorXd::LinSpaced(n, -1.0, 1.0), rhs(n + m);
+        rhs.head(n) = Eigen::VectorXd::LinSpaced(n, 2.0, -3.0);
+        Eigen::VectorXd g(m);
+        odyn::jacobian_times(model, ws, x0, g);
+        rhs.tail(m) = g;
+        Eigen::VectorXd a = Eigen::VectorXd::Zero(n + m), b = Eigen::VectorXd::Zero(n + m);
+        pinned.solve(rhs, a);
+        dense.solve(rhs, b);
+        // Both solve the system (A = M here: no force has stiffness blocks) to rounding, and
+        // agree on x to the conditioning of S (long hinged chains: see singular_pivot_ratio).
+        const auto residual = [&](const Eigen::VectorXd& solution) {
+          Eigen::VectorXd top(n), bottom(m);
+          odyn::mass_times(model, solution.head(n), top);
+          odyn::add_jacobian_transpose_times(model, ws, solution.tail(m), top);
+          odyn::jacobian_times(model, ws, solution.head(n), bottom);
+          return std::max((top - rhs.head(n)).cwiseAbs().maxCoeff(),
+                          (bottom - g).cwiseAbs().maxCoeff());
+        };
+        const auto scale = [&](const Eigen::VectorXd& solution) {
+          return std::max(rhs.cwiseAbs().maxCoeff(), solution.cwiseAbs().maxCoeff());
+        };
+        CHECK(residual(a) <= 1e-11 * scale(a));
+        CHECK(residual(b) <= 1e-11 * scale(b));
+        CAPTURE(residual(a), residual(b), scale(a), scale(b));
+        CHECK((a.head(n) - b.head(n)).norm() <= 1e-8 * b.head(n).norm());
+        Eigen::VectorXd forces_a = Eigen::VectorXd::Zero(n), forces_b = Eigen::VectorXd::Zero(n);
+        odyn::add_jacobian_transpose_times(model, ws, a.tail(m), forces_a);
+        odyn::add_jacobian_transpose_times(model, ws, b.tail(m), forces_b);
+        CHECK((forces_a - forces_b).norm() <= 1e-8 * forces_b.norm());
+        for (const auto& e : odyn::redundant_equations(model, ws)) CHECK(a[n + e.row] == 0.0);
+      }
+  }
+  SECTION("a run against the dense path's run") {
+    odyn::DynamicsSettings s;
+    s.t_end = 0.05;
+    s.step = 1e-3;
+    s.output_interval = 0.05;
+    odyn::Workspace<HingedModel> sparse_ws(model), dense_ws(model);
+    const auto ignore = [](const auto&) {};
+    const odyn::RunSummary sparse = odyn::simulate(model, sparse_ws, s, ignore);
+    s.linear_solver = odyn::LinearSolver::dense;
+    const odyn::RunSummary dense = odyn::simulate(model, dense_ws, s, ignore);
+    CHECK(sparse.redundant_equations.size() == 30);
+    CHECK((sparse_ws.q - dense_ws.q).cwiseAbs().maxCoeff() <= 1e-9);
+    CHECK(sparse_ws.phi.cwiseAbs().maxCoeff() <= 1e-10);
+    // A parallelogram's bar translates: every bar keeps its orientation (identity).
+    for (int cell = 0; cell < 10; ++cell) {
+      const Eigen::Vector4d orientation = sparse_ws.q.segment<4>((3 * cell + 2) * 7 + 3);
+      CHECK((orientation - Eigen::Vector4d(1, 0, 0, 0)).cwiseAbs().maxCoeff() <= 1e-9);
+    }
+    // The bars have fallen: the last one by more than 5 mm (free fall: 12 mm).
+    CHECK(sparse_ws.q[(3 * 9 + 2) * 7 + 1] < -0.005);
+    Eigen::VectorXd forces_sparse = Eigen::VectorXd::Zero(n),
+                    forces_dense = Eigen::VectorXd::Zero(n);
+    odyn::update_frames(model, sparse_ws);
+    odyn::evaluate_constraints(model, sparse_ws);
+    odyn::add_jacobian_transpose_times(model, sparse_ws, sparse_ws.lambda, forces_sparse);
+    odyn::add_jacobian_transpose_times(model, sparse_ws, dense_ws.lambda, forces_dense);
+    CHECK((forces_sparse - forces_dense).cwiseAbs().maxCoeff() <=
+          1e-6 * forces_dense.cwiseAbs().maxCoeff());
+    CHECK(sparse.statistics.steps == 50);
+  }
+}
+
 TEST_CASE("A hanging chain on the sparse path swings at its analytic frequencies",
           "[sparse][dynamics]") {
   // N uniform links (mass m, length l, inertia m l^2 / 12 across) hanging from ball joints.

@@ -164,9 +164,10 @@ class AbsoluteCoordinates {
   /// How much the geometric stiffness weighed in the last factorization (see the solver).
   double geometric_share() const { return solver_.geometric_share(); }
   /// With redundant equations, the multipliers of least norm among those that give the same
-  /// constraint forces (their reactions are then one choice among many).
+  /// constraint forces (their reactions are then one choice among many), unless the solver
+  /// pinned the redundant ones (large models).
   void make_multipliers_unique() {
-    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
+    if (needs_minimum_norm_multipliers(solver_)) make_multipliers_minimum_norm(model_, ws_);
   }
 
   /// max |M^-1 r| by the mass matrix's diagonal: a cheap estimate of the next Newton correction

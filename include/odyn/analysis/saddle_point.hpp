@@ -33,6 +33,10 @@
 // extrapolates lambda from step to step carries a null-space part along, which grows as the
 // null space turns with the pose, unless it projects lambda after each step (rank_deficiency()
 // says when that is needed). B^T lambda, and so the motion, is unaffected.
+// Large models (the sparse paths) keep their linear cost instead: the rows of B that repeat
+// earlier ones are pinned (their multipliers stay at zero, as the sparse assembly leaves them)
+// and the rest is factorized, still sparse; see pin_dependent_rows. Their reactions are then
+// the other valid choice, all of a repeated joint's load on the joint that came first.
 // An inconsistent right-hand side (constraints that cannot all hold, or a driver at a dead
 // point) gets the least-squares y: the constraint residual then does not vanish and the
 // caller's convergence test fails, so it never hides.
@@ -55,6 +59,7 @@
 #include <variant>
 #include <vector>
 
+#include "odyn/analysis/sparse_assembly.hpp"
 #include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -315,7 +320,7 @@ class BlockSchurSaddlePoint {
       rank_deficiency_ = 0;
       return true;
     }
-    return path_ == Path::sparse_schur ? factorize_sparse_schur() : factorize_schur();
+    return path_ == Path::sparse_schur ? factorize_sparse_schur(model, ws) : factorize_schur();
   }
 
   /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
@@ -323,6 +328,14 @@ class BlockSchurSaddlePoint {
     if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.rank_deficiency();
     if (path_ == Path::sparse_kkt || whole_ == Whole::sparse) return sparse_kkt_.rank_deficiency();
     return rank_deficiency_;
+  }
+
+  /// True if the last factorization pinned the multipliers of redundant equations (see
+  /// pin_dependent_rows): they then need no minimum-norm projection.
+  bool multipliers_pinned() const {
+    if (path_ == Path::sparse_kkt || whole_ == Whole::sparse)
+      return sparse_kkt_.multipliers_pinned();
+    return path_ == Path::sparse_schur && whole_ == Whole::none && method_ == Method::sparse_pinned;
   }
 
   /// |A_sym^-1 A_skew| of the last factorization (largest over the bodies): what the Schur
@@ -383,6 +396,11 @@ class BlockSchurSaddlePoint {
         solution.tail(m_) = work_m_;
         sparse_cholesky_.solve_in_place(solution.tail(m_));
         break;
+      case Method::sparse_pinned:  // the pinned rows' multipliers do not move
+        for (const int row : pinned_rows_) work_m_[row] = 0.0;
+        solution.tail(m_) = work_m_;
+        sparse_cholesky_.solve_in_place(solution.tail(m_));
+        break;
       case Method::lu:
         solution.tail(m_) = work_m_;
         schur_lu_.solve_in_place(solution.tail(m_));
@@ -408,7 +426,7 @@ class BlockSchurSaddlePoint {
   }
 
  private:
-  enum class Method { cholesky, sparse_cholesky, lu, minimum_norm };
+  enum class Method { cholesky, sparse_cholesky, sparse_pinned, lu, minimum_norm };
   enum class Path { dense_schur, sparse_schur, dense_kkt, sparse_kkt };
   /// Which whole-matrix factorization stands in for a Schur path's, if any.
   enum class Whole { none, dense, sparse };
@@ -597,12 +615,18 @@ class BlockSchurSaddlePoint {
   /// model (7.5e-9 at 256 links, 1.2e-10 at 1024), and would be taken for a redundancy.
   static constexpr double singular_pivot_ratio = 1e-13;
 
-  /// Factorizes the sparse S by CHOLMOD. When S is not positive definite or singular (A
-  /// indefinite, or redundant constraints), it goes the dense way below: correct, but O(m^3),
-  /// so large over-constrained models are not on the linear-cost path yet.
-  bool factorize_sparse_schur() {
+  /// Factorizes the sparse S by CHOLMOD. When S is singular because rows of Phi_q repeat
+  /// others (redundant constraints), those rows are pinned (see pin_dependent_rows) and the
+  /// rest is factorized, still sparse. When S is not positive definite (A indefinite) or
+  /// singular for another reason (a dead point), it goes the dense way below: correct, but
+  /// O(m^3).
+  bool factorize_sparse_schur(const Model& model, const Workspace<Model>& ws) {
     rank_deficiency_ = 0;
     const std::vector<double>& values = sparse_schur_.gather();
+    // Rows pinned last time are likely to repeat others again: look first (linear cost), and
+    // spare the factorization that would fail.
+    const bool pinned_before = method_ == Method::sparse_pinned;
+    if (pinned_before && pin_dependent_rows(model, ws, values)) return true;
     if (sparse_cholesky_.factorize(values) &&
         sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio) {
       method_ = Method::sparse_cholesky;
@@ -610,10 +634,43 @@ class BlockSchurSaddlePoint {
     }
     for (const double x : values)
       if (!std::isfinite(x)) return false;
+    if (!pinned_before && pin_dependent_rows(model, ws, values)) return true;
     schur_ = sparse_schur_.to_dense();
     schur_cholesky_.resize(m_);
     schur_lu_.resize(m_);
     return factorize_schur();
+  }
+
+  /// Redundant constraints on the sparse path. The rows of Phi_q that repeat earlier ones
+  /// (sparse elimination in row order, as the sparse assembly decides them: linear cost) are
+  /// pinned: their rows and columns of S are cleared but for the diagonal, so that a solve
+  /// leaves their multipliers where they are (zero, from the sparse assembly) and the other
+  /// rows' multipliers carry the constraint forces. For consistent redundant equations that is
+  /// one valid solution, not the minimum-norm one of the dense solvers (the reactions are not
+  /// unique either way; see the top of this file). False if no row repeats others, or if the
+  /// rest is still singular.
+  bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
+                          const std::vector<double>& values) {
+    const std::vector<char> independent =
+        detail::independent_rows(detail::sparse_jacobian(model, ws), rank_tolerance);
+    pinned_rows_.clear();
+    for (int row = 0; row < m_; ++row)
+      if (!independent[row]) pinned_rows_.push_back(row);
+    if (pinned_rows_.empty()) return false;
+    std::vector<char> pinned(static_cast<std::size_t>(m_), 0);
+    for (const int row : pinned_rows_) pinned[row] = 1;
+    pinned_values_ = values;
+    const std::vector<int>& starts = sparse_schur_.column_starts();
+    const std::vector<int>& rows = sparse_schur_.row_indices();
+    for (int column = 0; column < m_; ++column)
+      for (int k = starts[column]; k < starts[column + 1]; ++k)
+        if ((pinned[rows[k]] || pinned[column]) && rows[k] != column) pinned_values_[k] = 0.0;
+    if (!sparse_cholesky_.factorize(pinned_values_) ||
+        !(sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio))
+      return false;
+    method_ = Method::sparse_pinned;
+    rank_deficiency_ = static_cast<int>(pinned_rows_.size());
+    return true;
   }
 
   /// Factorizes the assembled S: Cholesky, else LU, else (singular) a complete orthogonal
@@ -675,7 +732,18 @@ class BlockSchurSaddlePoint {
   SmallCholesky schur_cholesky_;
   PivotedLu schur_lu_;                  // S not positive definite
   RankRevealingQr schur_minimum_norm_;  // S singular
+  std::vector<int> pinned_rows_;        // rows of Phi_q that repeat others (sparse_pinned)
+  std::vector<double> pinned_values_;   // S's values with those rows and columns cleared
   Eigen::VectorXd work_m_, work_y_, work_qr_;
 };
+
+/// Whether the multipliers need the minimum-norm projection (make_multipliers_minimum_norm)
+/// after the solver's last factorization: it found redundant equations and did not pin them.
+template <class Solver>
+bool needs_minimum_norm_multipliers(const Solver& solver) {
+  if constexpr (requires { solver.multipliers_pinned(); })
+    if (solver.multipliers_pinned()) return false;
+  return solver.rank_deficiency() > 0;
+}
 
 }  // namespace odyn

@@ -12,14 +12,18 @@
 // nothing. The LU keeps its pivot order from one factorization to the next while it stays
 // good (linalg/sparse_lu.hpp).
 //
-// A singular matrix (redundant constraints) falls back to a dense complete orthogonal
-// decomposition, which gives the minimum-norm multipliers as the dense solvers do
-// (analysis/saddle_point.hpp) but costs O((n + m)^3): large over-constrained models are not on
-// the linear-cost path yet.
+// A singular matrix from redundant constraints stays sparse: the rows of B that repeat earlier
+// ones (sparse elimination in row order, as the sparse assembly decides them) are pinned, their
+// rows and columns cleared but for a unit diagonal (declared in the pattern, zero otherwise), so
+// that their multipliers do not move and the other rows carry the constraint forces. That is one
+// valid choice of multipliers, not the minimum-norm one of the dense solvers
+// (analysis/saddle_point.hpp). A matrix singular for another reason (a dead point) falls back
+// to a dense complete orthogonal decomposition, O((n + m)^3).
 
 #include <Eigen/Core>
 #include <vector>
 
+#include "odyn/analysis/sparse_assembly.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/linalg/block_sparse.hpp"
 #include "odyn/linalg/rank_revealing_qr.hpp"
@@ -66,10 +70,14 @@ class SparseKktSaddlePoint {
           }
       }
     });
+    // The multipliers' diagonal, zero but where a redundant row is pinned (AMD, which orders
+    // the pattern, ignores diagonal entries).
+    for (int row = n_; row < n_ + m_; ++row) matrix_.declare(row, row, 1, 1);
     matrix_.finalize(BlockSparseMatrix::Triangle::full);
     lu_.analyze(n_ + m_, matrix_.column_starts(), matrix_.row_indices());
     rank_deficiency_ = 0;
     minimum_norm_ = false;
+    pinned_rows_.clear();
   }
 
   /// Factorizes by sparse LU; if the matrix is singular (redundant constraints), by a dense
@@ -81,37 +89,73 @@ class SparseKktSaddlePoint {
     const std::vector<double>& values = matrix_.gather();
     rank_deficiency_ = 0;
     minimum_norm_ = false;
+    // Rows pinned last time are likely to repeat others again: look first (linear cost), and
+    // spare the LU that would fail.
+    const bool pinned_before = !pinned_rows_.empty();
+    pinned_rows_.clear();
+    if (pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    pinned_rows_.clear();
     if (lu_.factorize(values)) return true;
     for (const double x : values)
       if (!std::isfinite(x)) return false;
+    if (!pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    pinned_rows_.clear();
     minimum_norm_ = true;
     dense_.compute(matrix_.to_dense(), rank_tolerance);
     rank_deficiency_ = static_cast<int>(n_ + m_ - dense_.rank());
     return true;
   }
 
-  /// rhs = [f; g] -> solution = [x; y] (minimum-norm y after a singular factorization).
+  /// rhs = [f; g] -> solution = [x; y] (minimum-norm y after a singular factorization that
+  /// could not pin its redundant rows).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
     if (minimum_norm_) {
       dense_.solve(rhs, solution, work_);
       return;
     }
     solution = rhs;
+    for (const int row : pinned_rows_) solution[n_ + row] = 0.0;  // their multipliers stay
     lu_.solve_in_place(solution);
   }
 
   int rank_deficiency() const { return rank_deficiency_; }
+  /// True if the last factorization pinned redundant rows (no minimum-norm projection then).
+  bool multipliers_pinned() const { return !pinned_rows_.empty(); }
   /// Factorizations that chose their pivots afresh.
   long pivoting_factorizations() const { return lu_.pivoting_factorizations(); }
 
  private:
+  /// Pins the rows of B that repeat earlier ones (see the top of this file) and factorizes
+  /// again. False if none repeats others or the matrix is still singular.
+  bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
+                          const std::vector<double>& values) {
+    const std::vector<char> independent =
+        detail::independent_rows(detail::sparse_jacobian(model, ws), rank_tolerance);
+    for (int row = 0; row < m_; ++row)
+      if (!independent[row]) pinned_rows_.push_back(row);
+    if (pinned_rows_.empty()) return false;
+    std::vector<char> pinned(static_cast<std::size_t>(n_ + m_), 0);
+    for (const int row : pinned_rows_) pinned[n_ + row] = 1;
+    pinned_values_ = values;
+    const std::vector<int>& starts = matrix_.column_starts();
+    const std::vector<int>& rows = matrix_.row_indices();
+    for (int column = 0; column < n_ + m_; ++column)
+      for (int k = starts[column]; k < starts[column + 1]; ++k)
+        if (pinned[rows[k]] || pinned[column]) pinned_values_[k] = rows[k] == column ? 1.0 : 0.0;
+    if (!lu_.factorize(pinned_values_)) return false;
+    rank_deficiency_ = static_cast<int>(pinned_rows_.size());
+    return true;
+  }
+
   int n_ = 0, m_ = 0;
   int rank_deficiency_ = 0;
   bool minimum_norm_ = false;
   BlockSparseMatrix matrix_;  // (n + m) x (n + m)
   SparseLu lu_;
-  RankRevealingQr dense_;  // only after a singular factorization
+  RankRevealingQr dense_;  // only after a singular factorization that pinning did not cure
   Eigen::VectorXd work_;
+  std::vector<int> pinned_rows_;       // rows of B that repeat others (after a singular LU)
+  std::vector<double> pinned_values_;  // the matrix's values with them cleared
 };
 
 }  // namespace odyn

@@ -303,7 +303,7 @@ class Bdf {
 
   /// Makes the trial state of the last attempt the committed one (no step-size change).
   void commit() {
-    if (solver_.rank_deficiency() > 0) make_multipliers_minimum_norm(model_, ws_);
+    if (needs_minimum_norm_multipliers(solver_)) make_multipliers_minimum_norm(model_, ws_);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     y_new_ << ws_.q, ws_.v, ws_.lambda;
     push(y_new_, ws_.t);
