@@ -113,13 +113,13 @@ bool sparse_assembly(const Model& model, const AssemblySettings& s) {
 
 /// The rows of Phi_q (at the blocks of the last evaluate_constraints) that depend on others:
 /// by a rank-revealing QR of the dense matrix for small models, and for large ones (past
-/// dense_assembly_limit) by sparse elimination in row order, which names the later of two
-/// dependent rows.
+/// dense_assembly_limit) by sparse elimination in the model's topological order (see
+/// independent_rows), which names rows of the joints that close loops.
 template <class Model>
 std::vector<int> dependent_rows(const Model& model, const Workspace<Model>& ws) {
   if (!sparse_assembly(model, AssemblySettings{})) return dependent_rows(dense_jacobian(model, ws));
   const std::vector<char> independent =
-      independent_rows(sparse_jacobian(model, ws), rank_tolerance);
+      independent_rows(model, sparse_jacobian(model, ws), rank_tolerance);
   std::vector<int> rows;
   for (int r = 0; r < static_cast<int>(independent.size()); ++r)
     if (!independent[r]) rows.push_back(r);
@@ -139,7 +139,7 @@ template <class Model>
 Eigen::VectorXd sparse_position_step(const Model& model, const Workspace<Model>& ws) {
   constexpr int nv = Model::nv;
   const SparseRows rows = sparse_jacobian(model, ws);
-  const std::vector<char> use = independent_rows(rows, rank_tolerance);
+  const std::vector<char> use = independent_rows(model, rows, rank_tolerance);
   Eigen::VectorXd g(std::count(use.begin(), use.end(), 1));
   for (int r = 0, k = 0; r < rows.num_rows(); ++r)
     if (use[r]) g[k++] = -ws.phi[r];
@@ -184,7 +184,7 @@ void assemble_velocities_and_accelerations_sparse(const Model& model, Workspace<
   constexpr int nv = Model::nv;
   const int m = model.num_equations(), n = model.num_velocities();
   const SparseRows rows = sparse_jacobian(model, ws);
-  const std::vector<char> use = independent_rows(rows, rank_tolerance);
+  const std::vector<char> use = independent_rows(model, rows, rank_tolerance);
   const int independent = static_cast<int>(std::count(use.begin(), use.end(), 1));
   std::vector<int> given;
   for (int b = 1; b <= model.num_bodies(); ++b) {
@@ -391,7 +391,7 @@ void assemble_accelerations(const Model& model, Workspace<Model>& ws,
   if (detail::sparse_assembly(model, s)) {
     const detail::SparseRows rows = detail::sparse_jacobian(model, ws);
     detail::solve_accelerations_sparse(model, ws, rows,
-                                       detail::independent_rows(rows, rank_tolerance));
+                                       detail::independent_rows(model, rows, rank_tolerance));
   } else {
     detail::solve_accelerations_dense(detail::dense_mass(model), detail::dense_jacobian(model, ws),
                                       ws);

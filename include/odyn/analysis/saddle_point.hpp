@@ -642,8 +642,8 @@ class BlockSchurSaddlePoint {
   }
 
   /// Redundant constraints on the sparse path. The rows of Phi_q that repeat earlier ones
-  /// (sparse elimination in row order, as the sparse assembly decides them: linear cost) are
-  /// pinned: their rows and columns of S are cleared but for the diagonal, so that a solve
+  /// (sparse elimination in topological order, as the sparse assembly decides them: linear cost)
+  /// are pinned: their rows and columns of S are cleared but for the diagonal, so that a solve
   /// leaves their multipliers where they are (zero, from the sparse assembly) and the other
   /// rows' multipliers carry the constraint forces. For consistent redundant equations that is
   /// one valid solution, not the minimum-norm one of the dense solvers (the reactions are not
@@ -652,7 +652,7 @@ class BlockSchurSaddlePoint {
   bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
                           const std::vector<double>& values) {
     const std::vector<char> independent =
-        detail::independent_rows(detail::sparse_jacobian(model, ws), rank_tolerance);
+        detail::independent_rows(model, detail::sparse_jacobian(model, ws), rank_tolerance);
     pinned_rows_.clear();
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "odyn/analysis/system.hpp"
@@ -64,19 +65,104 @@ SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
   return rows;
 }
 
-/// For each row of Phi_q: false if it depends on the rows before it.
-inline std::vector<char> independent_rows(const SparseRows& rows, double tolerance) {
+/// For each row of Phi_q: false if it repeats others. The rows are eliminated in an order
+/// taken from the model's topology, so that the fill stays within each loop whatever the pose
+/// (in row order, pivoting on the largest entries, it grew as N^2 on a turned rope). The
+/// joints form a graph on the bodies, the ground one of them; those that first reach a body,
+/// in the order they were added, form a spanning forest, rooted at the ground. Its joints come
+/// first, from the leaves to the roots, each row pivoting on its child body's columns: no row
+/// then touches a pivot of those before it, and nothing fills in. The joints that close loops
+/// come last, in the order they were added: reduced by the tree's rows, a loop row's entries
+/// run along both paths from its bodies up the tree and cancel where the paths meet (rigid
+/// motion leaves a joint's equations unchanged), so its fill is its loop's path, and it
+/// pivots on the body of that path nearest the root. The rows
+/// named dependent are those of the loop joints that repeat others: of two coaxial hinges
+/// between the same bodies, the one added later.
+/// `fill`, if given, receives the entries the elimination stored (its memory, for the tests).
+template <class Model>
+std::vector<char> independent_rows(const Model& model, const SparseRows& rows, double tolerance,
+                                   std::size_t* fill = nullptr) {
+  constexpr int nv = Model::nv;
+  struct Edge {
+    int row, equations, a, b;  // first row, rows, and its two bodies (0: the ground)
+  };
+  std::vector<Edge> edges;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (Constraint<E>) {
+      const auto& offsets = model.template rows<E>();
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        const auto& bodies = pool[i].bodies();
+        const int a = bodies.size() > 0 ? bodies[0].index : 0;
+        const int b = bodies.size() > 1 ? bodies[1].index : 0;
+        // An element on more than two bodies closes whatever it joins: a loop joint.
+        edges.push_back({offsets[i], E::num_equations, a, bodies.size() > 2 ? -1 : b});
+      }
+    }
+  });
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.row < y.row; });
+  // The spanning forest (union-find), then each body's depth and tree joint from the roots.
+  const int nodes = model.num_bodies() + 1;
+  std::vector<int> root(static_cast<std::size_t>(nodes));
+  for (int k = 0; k < nodes; ++k) root[k] = k;
+  const auto find = [&](int k) {
+    while (root[k] != k) k = root[k] = root[root[k]];
+    return k;
+  };
+  std::vector<char> in_tree(edges.size(), 0);
+  std::vector<std::vector<std::pair<int, int>>> neighbours(static_cast<std::size_t>(nodes));
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const Edge& edge = edges[e];
+    if (edge.b < 0 || edge.a == edge.b || find(edge.a) == find(edge.b)) continue;
+    root[find(edge.a)] = find(edge.b);
+    in_tree[e] = 1;
+    neighbours[edge.a].push_back({edge.b, static_cast<int>(e)});
+    neighbours[edge.b].push_back({edge.a, static_cast<int>(e)});
+  }
+  std::vector<int> depth(static_cast<std::size_t>(nodes), -1), child(edges.size(), 0);
+  std::vector<int> queue;
+  for (int start = 0; start < nodes; ++start) {
+    if (depth[start] >= 0) continue;
+    depth[start] = 0;
+    queue.assign(1, start);
+    for (std::size_t next = 0; next < queue.size(); ++next)
+      for (const auto& [other, e] : neighbours[queue[next]])
+        if (depth[other] < 0) {
+          depth[other] = depth[queue[next]] + 1;
+          child[e] = other;
+          queue.push_back(other);
+        }
+  }
+  // The tree's joints by their child's depth, deepest first; then the loop joints.
+  std::vector<int> order;
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    if (in_tree[e]) order.push_back(static_cast<int>(e));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int x, int y) { return depth[child[x]] > depth[child[y]]; });
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    if (!in_tree[e]) order.push_back(static_cast<int>(e));
+
   SparseBasis basis;
   basis.reset(rows.num_columns, tolerance);
-  std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()));
+  // A loop row pivots where its path is nearest the root: the loops further down, whose paths
+  // start there, then do not reach its pivots.
+  std::vector<int> column_depth(static_cast<std::size_t>(rows.num_columns));
+  for (int column = 0; column < rows.num_columns; ++column)
+    column_depth[column] = depth[column / nv + 1];
+  basis.rank_entries(std::move(column_depth));
+  std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()), 0);
   std::vector<int> indices;
   std::vector<double> values;
-  for (int r = 0; r < rows.num_rows(); ++r) {
-    indices.assign(rows.columns.begin() + rows.starts[r],
-                   rows.columns.begin() + rows.starts[r + 1]);
-    values.assign(rows.values.begin() + rows.starts[r], rows.values.begin() + rows.starts[r + 1]);
-    independent[r] = basis.add(indices, values) ? 1 : 0;
+  for (const int e : order) {
+    const int body = in_tree[e] ? child[e] : 0;  // the preferred pivots: its columns
+    const int begin = body > 0 ? (body - 1) * nv : 0, end = body > 0 ? begin + nv : 0;
+    for (int r = edges[e].row; r < edges[e].row + edges[e].equations; ++r) {
+      indices.assign(rows.columns.begin() + rows.starts[r],
+                     rows.columns.begin() + rows.starts[r + 1]);
+      values.assign(rows.values.begin() + rows.starts[r], rows.values.begin() + rows.starts[r + 1]);
+      independent[r] = basis.add(indices, values, begin, end) ? 1 : 0;
+    }
   }
+  if (fill != nullptr) *fill = basis.stored_entries();
   return independent;
 }
 

@@ -13,9 +13,9 @@
 // good (linalg/sparse_lu.hpp).
 //
 // A singular matrix from redundant constraints stays sparse: the rows of B that repeat earlier
-// ones (sparse elimination in row order, as the sparse assembly decides them) are pinned, their
-// rows and columns cleared but for a unit diagonal (declared in the pattern, zero otherwise), so
-// that their multipliers do not move and the other rows carry the constraint forces. That is one
+// ones (sparse elimination in topological order, as the sparse assembly decides them) are pinned,
+// their rows and columns cleared but for a unit diagonal (declared in the pattern, zero otherwise),
+// so that their multipliers do not move and the other rows carry the constraint forces. That is one
 // valid choice of multipliers, not the minimum-norm one of the dense solvers
 // (analysis/saddle_point.hpp). A matrix singular for another reason (a dead point) falls back
 // to a dense complete orthogonal decomposition, O((n + m)^3).
@@ -130,7 +130,7 @@ class SparseKktSaddlePoint {
   bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
                           const std::vector<double>& values) {
     const std::vector<char> independent =
-        detail::independent_rows(detail::sparse_jacobian(model, ws), rank_tolerance);
+        detail::independent_rows(model, detail::sparse_jacobian(model, ws), rank_tolerance);
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);
     if (pinned_rows_.empty()) return false;

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <functional>
 #include <queue>
+#include <utility>
 #include <vector>
 
 namespace odyn {
@@ -25,6 +26,7 @@ class SparseBasis {
   /// Starts an empty basis of vectors with `dimension` entries.
   void reset(int dimension, double tolerance) {
     tolerance_ = tolerance;
+    rank_.clear();
     pivot_of_.assign(static_cast<std::size_t>(dimension), -1);
     work_.assign(static_cast<std::size_t>(dimension), 0.0);
     touched_mark_.assign(static_cast<std::size_t>(dimension), 0);
@@ -34,9 +36,17 @@ class SparseBasis {
     entry_value_.clear();
   }
 
+  /// Ranks the entries for the pivots of add() without a preferred range: among the entries
+  /// within a factor pivot_threshold of the largest, the lowest rank wins (then the largest).
+  /// Empty: the largest entry.
+  void rank_entries(std::vector<int> rank) { rank_ = std::move(rank); }
+
   /// Adds the vector with these nonzero entries if it is independent of those added before;
-  /// returns whether it was.
-  bool add(const std::vector<int>& indices, const std::vector<double>& values) {
+  /// returns whether it was. Its pivot, if kept, is its largest entry, or the largest in the
+  /// index range [prefer_begin, prefer_end) if that one is within a factor pivot_threshold of
+  /// the largest: a caller that knows where pivots cause no fill (a body's own columns) says so.
+  bool add(const std::vector<int>& indices, const std::vector<double>& values, int prefer_begin = 0,
+           int prefer_end = 0) {
     double scale = 0.0;
     for (std::size_t k = 0; k < indices.size(); ++k) {
       touch(indices[k]);
@@ -54,9 +64,11 @@ class SparseBasis {
       if (k == last) continue;
       last = k;
       const Pivot& pivot = pivots_[k];
-      const double factor = work_[pivot.index] / pivot.value;
+      // What rounding leaves at a pivot (where two paths of a loop cancel) is not carried on.
+      const double at_pivot = work_[pivot.index];
       work_[pivot.index] = 0.0;
-      if (factor == 0.0) continue;
+      if (std::abs(at_pivot) <= negligible * scale) continue;
+      const double factor = at_pivot / pivot.value;
       for (int e = pivot.begin; e < pivot.end; ++e) {
         const int j = entry_index_[e];
         if (!touched_mark_[j]) {
@@ -76,11 +88,29 @@ class SparseBasis {
       }
     const bool independent = scale > 0.0 && largest > tolerance_ * scale;
     if (independent) {
+      double preferred = 0.0;
+      int preferred_index = -1;
+      for (const int i : touched_)
+        if (i >= prefer_begin && i < prefer_end && pivot_of_[i] < 0 &&
+            std::abs(work_[i]) > preferred) {
+          preferred = std::abs(work_[i]);
+          preferred_index = i;
+        }
+      if (preferred_index >= 0 && preferred >= pivot_threshold * largest) {
+        largest_index = preferred_index;
+      } else if (!rank_.empty()) {
+        int best = largest_index;
+        for (const int i : touched_)
+          if (pivot_of_[i] < 0 && std::abs(work_[i]) >= pivot_threshold * largest &&
+              (rank_[i] < rank_[best] ||
+               (rank_[i] == rank_[best] && std::abs(work_[i]) > std::abs(work_[best]))))
+            best = i;
+        largest_index = best;
+      }
       Pivot pivot{largest_index, work_[largest_index], static_cast<int>(entry_index_.size()), 0};
       // Entries below rounding are dropped: they would only spread fill.
-      const double negligible = 1e-15 * scale;
       for (const int i : touched_)
-        if (i != largest_index && pivot_of_[i] < 0 && std::abs(work_[i]) > negligible) {
+        if (i != largest_index && pivot_of_[i] < 0 && std::abs(work_[i]) > negligible * scale) {
           entry_index_.push_back(i);
           entry_value_.push_back(work_[i]);
         }
@@ -113,7 +143,10 @@ class SparseBasis {
     touched_.push_back(i);
   }
 
+  static constexpr double negligible = 1e-15;     // relative to a vector's largest entry
+  static constexpr double pivot_threshold = 0.1;  // for a preferred pivot
   double tolerance_ = 0.0;
+  std::vector<int> rank_;           // (dimension or empty) see rank_entries
   std::vector<int> pivot_of_;       // (dimension) the kept vector pivoting on each entry, or -1
   std::vector<double> work_;        // (dimension) the vector being reduced
   std::vector<char> touched_mark_;  // (dimension)
