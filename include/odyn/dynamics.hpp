@@ -61,7 +61,7 @@ struct RunSummary {
   bool assembly_reused = false;  // started from an AssembledStart's state, not assembled again
   long outputs = 0;
   double wall_seconds = 0.0;           // the whole run
-  double setup_seconds = 0.0;          // of which assembly and the integrator's setup
+  double setup_seconds = 0.0;          // of which assembly (unless reused), integrator setup
   double max_position_residual = 0.0;  // max |Phi| at the output times
   double max_velocity_residual = 0.0;  // max |Phi_q v + Phi_t| at the output times
   /// Constraint equations that repeat others at the assembled pose (Phi_q rank-deficient): the
@@ -74,7 +74,7 @@ struct RunSummary {
 /// runs of one model (Python keeps one per model until the model changes). simulate() fills an
 /// empty one when it assembles; given a filled one, it starts from that state instead of
 /// assembling again, if the settings' assembly settings are the same and the state still is
-/// assembled (see is_assembled): else it assembles afresh. Accelerations and multipliers that no
+/// assembled (see check_assembled): else it assembles afresh. Accelerations and multipliers that no
 /// longer solve the equations of motion (a Python force that changed) are solved again.
 template <class Model>
 struct AssembledStart {

@@ -255,9 +255,9 @@ def _warn_redundant(result: Result) -> None:
         named = ", ".join(f"{e['joint']} (equation {e['equation']})" for e in equations)
         warnings.warn(RedundantConstraintsWarning(
             f"{named}: constraint equations are redundant (they repeat what other joints "
-            "already impose); the analysis uses the minimum-norm multipliers, so these "
-            "reactions are one choice among many. Replace a joint by one with fewer equations "
-            "if you need them."), stacklevel=3)
+            "already impose); the analysis uses the minimum-norm multipliers (large models: "
+            "zero for these equations), so these reactions are one choice among many. Replace "
+            "a joint by one with fewer equations if you need them."), stacklevel=3)
 
 
 #: The factorizations `linear_solver` may name (see `simulate`).
