@@ -105,7 +105,8 @@ def main():
         # simulate_s: per step, since the step count changes with N.
         fits = [exponent([(r["N"], r[c] / (r["steps"] if c == "simulate_s" else 1))
                           for r in chosen]) for c in COLUMNS]
-        lines.append(f"| {case} | " + " | ".join(f"{p:.2f}" for p in fits) + " |")
+        lines.append(f"| {case} | " + " | ".join(f"{p:.2f}" if math.isfinite(p) else "-"
+                                                  for p in fits) + " |")
     with open(os.path.join(args.out_dir, "python_setup.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
