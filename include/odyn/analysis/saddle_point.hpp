@@ -299,6 +299,7 @@ class BlockSchurSaddlePoint {
     work_qr_ = Eigen::VectorXd::Zero(m_);
     method_ = Method::cholesky;
     rank_deficiency_ = 0;
+    row_order_ = {};
   }
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
@@ -651,13 +652,15 @@ class BlockSchurSaddlePoint {
   /// rest is still singular.
   bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
                           const std::vector<double>& values) {
+    if (row_order_.elements.empty()) row_order_ = detail::row_order(model);  // once a model
     const std::vector<char> independent =
-        detail::independent_rows(model, detail::sparse_jacobian(model, ws), rank_tolerance);
+        detail::independent_rows(row_order_, detail::sparse_jacobian(model, ws), rank_tolerance);
     pinned_rows_.clear();
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);
     if (pinned_rows_.empty()) return false;
-    std::vector<char> pinned(static_cast<std::size_t>(m_), 0);
+    std::vector<char>& pinned = pinned_mark_;
+    pinned.assign(static_cast<std::size_t>(m_), 0);
     for (const int row : pinned_rows_) pinned[row] = 1;
     pinned_values_ = values;
     const std::vector<int>& starts = sparse_schur_.column_starts();
@@ -734,6 +737,8 @@ class BlockSchurSaddlePoint {
   RankRevealingQr schur_minimum_norm_;  // S singular
   std::vector<int> pinned_rows_;        // rows of Phi_q that repeat others (sparse_pinned)
   std::vector<double> pinned_values_;   // S's values with those rows and columns cleared
+  std::vector<char> pinned_mark_;       // (scratch) 1 on the pinned rows
+  detail::RowOrder row_order_;          // how to find them (built on the first need)
   Eigen::VectorXd work_m_, work_y_, work_qr_;
 };
 

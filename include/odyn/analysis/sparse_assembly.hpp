@@ -78,10 +78,18 @@ SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
 /// pivots on the body of that path nearest the root. The rows
 /// named dependent are those of the loop joints that repeat others: of two coaxial hinges
 /// between the same bodies, the one added later.
-/// `fill`, if given, receives the entries the elimination stored (its memory, for the tests).
+/// The order of independent_rows, from the model's topology alone: built once per model.
+struct RowOrder {
+  struct Rows {
+    int first, count;            // an element's rows
+    int pivot_begin, pivot_end;  // the columns its rows prefer as pivots (empty: none)
+  };
+  std::vector<Rows> elements;     // in elimination order
+  std::vector<int> column_depth;  // the depth in the tree of each column's body
+};
+
 template <class Model>
-std::vector<char> independent_rows(const Model& model, const SparseRows& rows, double tolerance,
-                                   std::size_t* fill = nullptr) {
+RowOrder row_order(const Model& model) {
   constexpr int nv = Model::nv;
   struct Edge {
     int row, equations, a, b;  // first row, rows, and its two bodies (0: the ground)
@@ -141,29 +149,45 @@ std::vector<char> independent_rows(const Model& model, const SparseRows& rows, d
   for (std::size_t e = 0; e < edges.size(); ++e)
     if (!in_tree[e]) order.push_back(static_cast<int>(e));
 
-  SparseBasis basis;
-  basis.reset(rows.num_columns, tolerance);
-  // A loop row pivots where its path is nearest the root: the loops further down, whose paths
-  // start there, then do not reach its pivots.
-  std::vector<int> column_depth(static_cast<std::size_t>(rows.num_columns));
-  for (int column = 0; column < rows.num_columns; ++column)
-    column_depth[column] = depth[column / nv + 1];
-  basis.rank_entries(std::move(column_depth));
-  std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()), 0);
-  std::vector<int> indices;
-  std::vector<double> values;
+  RowOrder out;
   for (const int e : order) {
     const int body = in_tree[e] ? child[e] : 0;  // the preferred pivots: its columns
     const int begin = body > 0 ? (body - 1) * nv : 0, end = body > 0 ? begin + nv : 0;
-    for (int r = edges[e].row; r < edges[e].row + edges[e].equations; ++r) {
+    out.elements.push_back({edges[e].row, edges[e].equations, begin, end});
+  }
+  // A loop row pivots where its path is nearest the root: the loops further down, whose paths
+  // start there, then do not reach its pivots.
+  out.column_depth.resize(static_cast<std::size_t>(model.num_velocities()));
+  for (int column = 0; column < model.num_velocities(); ++column)
+    out.column_depth[column] = depth[column / nv + 1];
+  return out;
+}
+
+/// independent_rows in a given order. `fill`, if given, receives the entries the elimination
+/// stored (its memory, for the tests).
+inline std::vector<char> independent_rows(const RowOrder& order, const SparseRows& rows,
+                                          double tolerance, std::size_t* fill = nullptr) {
+  SparseBasis basis;
+  basis.reset(rows.num_columns, tolerance);
+  basis.rank_entries(&order.column_depth);
+  std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()), 0);
+  std::vector<int> indices;
+  std::vector<double> values;
+  for (const RowOrder::Rows& element : order.elements)
+    for (int r = element.first; r < element.first + element.count; ++r) {
       indices.assign(rows.columns.begin() + rows.starts[r],
                      rows.columns.begin() + rows.starts[r + 1]);
       values.assign(rows.values.begin() + rows.starts[r], rows.values.begin() + rows.starts[r + 1]);
-      independent[r] = basis.add(indices, values, begin, end) ? 1 : 0;
+      independent[r] = basis.add(indices, values, element.pivot_begin, element.pivot_end) ? 1 : 0;
     }
-  }
   if (fill != nullptr) *fill = basis.stored_entries();
   return independent;
+}
+
+template <class Model>
+std::vector<char> independent_rows(const Model& model, const SparseRows& rows, double tolerance,
+                                   std::size_t* fill = nullptr) {
+  return independent_rows(row_order(model), rows, tolerance, fill);
 }
 
 /// Which given velocity components (indices into v, in the order the dense assembly takes

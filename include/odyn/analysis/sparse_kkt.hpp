@@ -78,6 +78,7 @@ class SparseKktSaddlePoint {
     rank_deficiency_ = 0;
     minimum_norm_ = false;
     pinned_rows_.clear();
+    row_order_ = {};
   }
 
   /// Factorizes by sparse LU; if the matrix is singular (redundant constraints), by a dense
@@ -129,12 +130,14 @@ class SparseKktSaddlePoint {
   /// again. False if none repeats others or the matrix is still singular.
   bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
                           const std::vector<double>& values) {
+    if (row_order_.elements.empty()) row_order_ = detail::row_order(model);  // once a model
     const std::vector<char> independent =
-        detail::independent_rows(model, detail::sparse_jacobian(model, ws), rank_tolerance);
+        detail::independent_rows(row_order_, detail::sparse_jacobian(model, ws), rank_tolerance);
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);
     if (pinned_rows_.empty()) return false;
-    std::vector<char> pinned(static_cast<std::size_t>(n_ + m_), 0);
+    std::vector<char>& pinned = pinned_mark_;
+    pinned.assign(static_cast<std::size_t>(n_ + m_), 0);
     for (const int row : pinned_rows_) pinned[n_ + row] = 1;
     pinned_values_ = values;
     const std::vector<int>& starts = matrix_.column_starts();
@@ -156,6 +159,8 @@ class SparseKktSaddlePoint {
   Eigen::VectorXd work_;
   std::vector<int> pinned_rows_;       // rows of B that repeat others (after a singular LU)
   std::vector<double> pinned_values_;  // the matrix's values with them cleared
+  std::vector<char> pinned_mark_;      // (scratch) 1 on the pinned rows
+  detail::RowOrder row_order_;         // how to find them (built on the first need)
 };
 
 }  // namespace odyn

@@ -26,7 +26,7 @@ class SparseBasis {
   /// Starts an empty basis of vectors with `dimension` entries.
   void reset(int dimension, double tolerance) {
     tolerance_ = tolerance;
-    rank_.clear();
+    rank_ = nullptr;
     pivot_of_.assign(static_cast<std::size_t>(dimension), -1);
     work_.assign(static_cast<std::size_t>(dimension), 0.0);
     touched_mark_.assign(static_cast<std::size_t>(dimension), 0);
@@ -38,8 +38,9 @@ class SparseBasis {
 
   /// Ranks the entries for the pivots of add() without a preferred range: among the entries
   /// within a factor pivot_threshold of the largest, the lowest rank wins (then the largest).
-  /// Empty: the largest entry.
-  void rank_entries(std::vector<int> rank) { rank_ = std::move(rank); }
+  /// None: the largest entry.
+  /// `rank` (one entry per index) must outlive the basis's use.
+  void rank_entries(const std::vector<int>* rank) { rank_ = rank; }
 
   /// Adds the vector with these nonzero entries if it is independent of those added before;
   /// returns whether it was. Its pivot, if kept, is its largest entry, or the largest in the
@@ -98,12 +99,13 @@ class SparseBasis {
         }
       if (preferred_index >= 0 && preferred >= pivot_threshold * largest) {
         largest_index = preferred_index;
-      } else if (!rank_.empty()) {
+      } else if (rank_ != nullptr) {
+        const std::vector<int>& rank = *rank_;
         int best = largest_index;
         for (const int i : touched_)
           if (pivot_of_[i] < 0 && std::abs(work_[i]) >= pivot_threshold * largest &&
-              (rank_[i] < rank_[best] ||
-               (rank_[i] == rank_[best] && std::abs(work_[i]) > std::abs(work_[best]))))
+              (rank[i] < rank[best] ||
+               (rank[i] == rank[best] && std::abs(work_[i]) > std::abs(work_[best]))))
             best = i;
         largest_index = best;
       }
@@ -146,7 +148,7 @@ class SparseBasis {
   static constexpr double negligible = 1e-15;     // relative to a vector's largest entry
   static constexpr double pivot_threshold = 0.1;  // for a preferred pivot
   double tolerance_ = 0.0;
-  std::vector<int> rank_;           // (dimension or empty) see rank_entries
+  const std::vector<int>* rank_ = nullptr;  // see rank_entries
   std::vector<int> pivot_of_;       // (dimension) the kept vector pivoting on each entry, or -1
   std::vector<double> work_;        // (dimension) the vector being reduced
   std::vector<char> touched_mark_;  // (dimension)
