@@ -590,6 +590,75 @@ void turn_rigidly(const Model& model, odyn::Workspace<Model>& ws) {
   odyn::evaluate_constraints(model, ws);
 }
 
+TEST_CASE("Pinned rows are kept while they repeat others, and decided again when they stop",
+          "[sparse][redundant]") {
+  // The rank pass that decides the pinned rows runs once; a pose where they still repeat
+  // others (the ladder turned rigidly) keeps them. Tilting one link's hinges makes its loop's
+  // rows independent: the pinned solve then leaves their equations unsolved, the solver sees
+  // it, and the next factorization decides again, as the dense rank does.
+  const HingedModel model = hinged_ladder(10);
+  const Eigen::Index n = model.num_velocities(), m = model.num_equations();
+  for (const auto& [choice, path] : {std::pair{odyn::LinearSolver::automatic, "cholmod-schur"},
+                                     std::pair{odyn::LinearSolver::klu, "klu"}}) {
+    INFO(path);
+    odyn::Workspace<HingedModel> ws(model);
+    odyn::assemble(model, ws);
+    odyn::BlockSchurSaddlePoint<HingedModel> pinned, dense;
+    pinned.choose(choice);
+    dense.choose(odyn::LinearSolver::dense);
+    pinned.analyze(model);
+    dense.analyze(model);
+    // g = B x0: consistent whatever the rank.
+    const auto solve_and_check = [&](double tolerance) {
+      const Eigen::VectorXd x0 = Eigen::VectorXd::LinSpaced(n, -1.0, 1.0);
+      Eigen::VectorXd rhs(n + m), g(m), solution = Eigen::VectorXd::Zero(n + m);
+      rhs.head(n) = Eigen::VectorXd::LinSpaced(n, 2.0, -3.0);
+      odyn::jacobian_times(model, ws, x0, g);
+      rhs.tail(m) = g;
+      pinned.solve(rhs, solution);
+      Eigen::VectorXd top(n), bottom(m);
+      odyn::mass_times(model, solution.head(n), top);
+      odyn::add_jacobian_transpose_times(model, ws, solution.tail(m), top);
+      odyn::jacobian_times(model, ws, solution.head(n), bottom);
+      const double residual =
+          std::max((top - rhs.head(n)).cwiseAbs().maxCoeff(), (bottom - g).cwiseAbs().maxCoeff());
+      const double scale = std::max(rhs.cwiseAbs().maxCoeff(), solution.cwiseAbs().maxCoeff());
+      CAPTURE(residual, scale);
+      if (tolerance > 0.0)
+        CHECK(residual <= tolerance * scale);
+      else
+        CHECK(residual > 1e-3 * scale);  // the pinned rows' equations, left unsolved
+    };
+    REQUIRE(pinned.factorize(model, ws, odyn::IterationFactors{}));
+    CHECK(pinned.rank_deficiency() == 30);
+    solve_and_check(1e-11);
+    turn_rigidly(model, ws);
+    REQUIRE(pinned.factorize(model, ws, odyn::IterationFactors{}));
+    CHECK(pinned.rank_deficiency() == 30);
+    CHECK(pinned.pin_decisions() == 1);
+    solve_and_check(1e-11);
+    // The last cell's left link, tilted by 0.1 rad about its own axis: its two hinges no
+    // longer parallel the others of its loop.
+    const int link = 3 * 9;
+    const Eigen::Quaterniond q(ws.q[7 * link + 3], ws.q[7 * link + 4], ws.q[7 * link + 5],
+                               ws.q[7 * link + 6]);
+    const Eigen::Quaterniond tilted =
+        q * Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Vector3d::UnitX()));
+    ws.q.segment<4>(7 * link + 3) << tilted.w(), tilted.x(), tilted.y(), tilted.z();
+    odyn::update_frames(model, ws);
+    odyn::evaluate_constraints(model, ws);
+    REQUIRE(dense.factorize(model, ws, odyn::IterationFactors{}));
+    REQUIRE(pinned.factorize(model, ws, odyn::IterationFactors{}));  // the rows kept
+    CHECK(pinned.pin_decisions() == 1);
+    solve_and_check(-1.0);
+    REQUIRE(pinned.factorize(model, ws, odyn::IterationFactors{}));  // decided again
+    CHECK(pinned.pin_decisions() == 2);
+    CHECK(dense.rank_deficiency() < 30);
+    CHECK(pinned.rank_deficiency() == dense.rank_deficiency());
+    solve_and_check(1e-11);
+  }
+}
+
 TEST_CASE("Rank decisions on large models fill in locally at any pose", "[sparse][redundant]") {
   // In row order, pivoting on the largest entries, the elimination's fill grew as N^2 once the
   // bodies were turned (16 s for a 16384-link rope). In the topological order it stays within

@@ -300,6 +300,8 @@ class BlockSchurSaddlePoint {
     method_ = Method::cholesky;
     rank_deficiency_ = 0;
     row_order_ = {};
+    kept_pinned_rows_.clear();
+    pins_doubted_ = false;
   }
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
@@ -338,6 +340,10 @@ class BlockSchurSaddlePoint {
       return sparse_kkt_.multipliers_pinned();
     return path_ == Path::sparse_schur && whole_ == Whole::none && method_ == Method::sparse_pinned;
   }
+
+  /// How many times the sparse paths decided which rows to pin by a rank pass (see
+  /// factorize_sparse_schur: once while the same rows keep repeating others).
+  long pin_decisions() const { return pin_decisions_ + sparse_kkt_.pin_decisions(); }
 
   /// |A_sym^-1 A_skew| of the last factorization (largest over the bodies): what the Schur
   /// paths compare with max_dropped_skew.
@@ -397,11 +403,17 @@ class BlockSchurSaddlePoint {
         solution.tail(m_) = work_m_;
         sparse_cholesky_.solve_in_place(solution.tail(m_));
         break;
-      case Method::sparse_pinned:  // the pinned rows' multipliers do not move
-        for (const int row : pinned_rows_) work_m_[row] = 0.0;
+      case Method::sparse_pinned: {  // the pinned rows' multipliers do not move
+        pinned_rhs_.resize(pinned_rows_.size());
+        for (std::size_t i = 0; i < pinned_rows_.size(); ++i) {
+          pinned_rhs_[i] = work_m_[pinned_rows_[i]];
+          work_m_[pinned_rows_[i]] = 0.0;
+        }
         solution.tail(m_) = work_m_;
         sparse_cholesky_.solve_in_place(solution.tail(m_));
+        check_pinned_rows(rhs.tail(m_).cwiseAbs().maxCoeff(), solution.tail(m_));
         break;
+      }
       case Method::lu:
         solution.tail(m_) = work_m_;
         schur_lu_.solve_in_place(solution.tail(m_));
@@ -624,10 +636,18 @@ class BlockSchurSaddlePoint {
   bool factorize_sparse_schur(const Model& model, const Workspace<Model>& ws) {
     rank_deficiency_ = 0;
     const std::vector<double>& values = sparse_schur_.gather();
-    // Rows pinned last time are likely to repeat others again: look first (linear cost), and
-    // spare the factorization that would fail.
+    // The rows pinned last time repeat the others again as the model moves on (parallel
+    // hinges stay parallel): they are kept, without a new rank pass, while the rest factorizes
+    // regularly and the solves find them consistent (see check_pinned_rows). A rank pass at a
+    // Newton iterate, where loops close only to the tolerance, would also lose the
+    // cancellation that keeps its elimination local. Decided afresh otherwise; the rows kept
+    // are the fallback if the new decision leaves S singular.
     const bool pinned_before = method_ == Method::sparse_pinned;
-    if (pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    const bool doubted = pins_doubted_;
+    if (pinned_before && !doubted && factorize_pinned(values)) return true;
+    if (pinned_before && (pin_dependent_rows(model, ws, values) ||
+                          (doubted && restore_pinned_rows() && factorize_pinned(values))))
+      return true;
     if (sparse_cholesky_.factorize(values) &&
         sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio) {
       method_ = Method::sparse_cholesky;
@@ -655,10 +675,26 @@ class BlockSchurSaddlePoint {
     if (row_order_.elements.empty()) row_order_ = detail::row_order(model);  // once a model
     const std::vector<char> independent =
         detail::independent_rows(row_order_, detail::sparse_jacobian(model, ws), rank_tolerance);
+    kept_pinned_rows_.swap(pinned_rows_);
     pinned_rows_.clear();
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);
-    if (pinned_rows_.empty()) return false;
+    pins_doubted_ = false;
+    ++pin_decisions_;
+
+    return !pinned_rows_.empty() && factorize_pinned(values);
+  }
+
+  /// Back to the rows pinned before the last decision (see factorize_sparse_schur).
+  bool restore_pinned_rows() {
+    if (kept_pinned_rows_.empty()) return false;
+    pinned_rows_.swap(kept_pinned_rows_);
+    kept_pinned_rows_.clear();
+    return true;
+  }
+
+  /// Factorizes S with the rows pinned_rows_ pinned. False if the rest is singular.
+  bool factorize_pinned(const std::vector<double>& values) {
     std::vector<char>& pinned = pinned_mark_;
     pinned.assign(static_cast<std::size_t>(m_), 0);
     for (const int row : pinned_rows_) pinned[row] = 1;
@@ -674,6 +710,35 @@ class BlockSchurSaddlePoint {
     method_ = Method::sparse_pinned;
     rank_deficiency_ = static_cast<int>(pinned_rows_.size());
     return true;
+  }
+
+  /// Whether the pinned rows still repeat the others: their equations of S y = rhs, which the
+  /// pinned solve left out, must hold with the y it found (to O(distance from the constraint
+  /// manifold), as a dependent row's consistency does at a Newton iterate). A row that
+  /// stopped repeating others (a mechanism leaving a singular configuration) fails this, and
+  /// the next factorization decides the pinned rows afresh. One pass over S's lower triangle.
+  template <class Multipliers>
+  void check_pinned_rows(double rhs_scale, const Multipliers& y) {
+    const std::vector<double>& values = sparse_schur_.values();
+    const std::vector<int>& starts = sparse_schur_.column_starts();
+    const std::vector<int>& rows = sparse_schur_.row_indices();
+    for (const int row : pinned_rows_) work_qr_[row] = work_y_[row] = 0.0;
+    const auto add = [&](int row, double term) {
+      work_qr_[row] += term;
+      work_y_[row] += std::abs(term);
+    };
+    for (int column = 0; column < m_; ++column)
+      for (int k = starts[column]; k < starts[column + 1]; ++k) {
+        const int row = rows[k];
+        if (pinned_mark_[row]) add(row, values[k] * y[column]);
+        if (pinned_mark_[column] && row != column) add(column, values[k] * y[row]);
+      }
+    double mismatch = 0.0, scale = rhs_scale;
+    for (std::size_t i = 0; i < pinned_rows_.size(); ++i) {
+      mismatch = std::max(mismatch, std::abs(work_qr_[pinned_rows_[i]] - pinned_rhs_[i]));
+      scale = std::max(scale, work_y_[pinned_rows_[i]]);
+    }
+    if (mismatch > pinned_consistency * scale) pins_doubted_ = true;
   }
 
   /// Factorizes the assembled S: Cholesky, else LU, else (singular) a complete orthogonal
@@ -737,7 +802,11 @@ class BlockSchurSaddlePoint {
   RankRevealingQr schur_minimum_norm_;  // S singular
   std::vector<int> pinned_rows_;        // rows of Phi_q that repeat others (sparse_pinned)
   std::vector<double> pinned_values_;   // S's values with those rows and columns cleared
-  std::vector<char> pinned_mark_;       // (scratch) 1 on the pinned rows
+  std::vector<char> pinned_mark_;       // 1 on the pinned rows
+  std::vector<int> kept_pinned_rows_;   // those pinned before the last decision
+  std::vector<double> pinned_rhs_;      // (scratch) their right-hand side in a solve
+  bool pins_doubted_ = false;           // a solve found a pinned row inconsistent
+  long pin_decisions_ = 0;              // rank passes that decided them
   detail::RowOrder row_order_;          // how to find them (built on the first need)
   Eigen::VectorXd work_m_, work_y_, work_qr_;
 };

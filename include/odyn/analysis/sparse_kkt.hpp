@@ -34,6 +34,11 @@ namespace odyn {
 /// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block, and whether the
 /// stiffness term also holds the constraints' geometric stiffness G = d(Phi_q^T lambda)/dq
 /// (see add_geometric_stiffness).
+/// Above this, relative to the size of its terms, a pinned row's equation left unsolved by a
+/// solve says that the row no longer repeats others (see check_pinned_rows): at a Newton
+/// iterate a repeated row holds to about the distance from the constraint manifold.
+inline constexpr double pinned_consistency = 1e-6;
+
 struct IterationFactors {
   double mass = 1.0;
   double stiffness = 0.0;
@@ -78,6 +83,10 @@ class SparseKktSaddlePoint {
     rank_deficiency_ = 0;
     minimum_norm_ = false;
     pinned_rows_.clear();
+    kept_pinned_rows_.clear();
+    pins_doubted_ = false;
+    pinned_products_.assign(static_cast<std::size_t>(n_ + m_), 0.0);
+    pinned_sizes_.assign(static_cast<std::size_t>(n_ + m_), 0.0);
     row_order_ = {};
   }
 
@@ -90,11 +99,14 @@ class SparseKktSaddlePoint {
     const std::vector<double>& values = matrix_.gather();
     rank_deficiency_ = 0;
     minimum_norm_ = false;
-    // Rows pinned last time are likely to repeat others again: look first (linear cost), and
-    // spare the LU that would fail.
+    // Rows pinned last time are kept while the rest factorizes regularly and the solves find
+    // them consistent, as BlockSchurSaddlePoint::factorize_sparse_schur keeps them.
     const bool pinned_before = !pinned_rows_.empty();
-    pinned_rows_.clear();
-    if (pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    const bool doubted = pins_doubted_;
+    if (pinned_before && !doubted && factorize_pinned(values)) return true;
+    if (pinned_before && (pin_dependent_rows(model, ws, values) ||
+                          (doubted && restore_pinned_rows() && factorize_pinned(values))))
+      return true;
     pinned_rows_.clear();
     if (lu_.factorize(values)) return true;
     for (const double x : values)
@@ -117,11 +129,14 @@ class SparseKktSaddlePoint {
     solution = rhs;
     for (const int row : pinned_rows_) solution[n_ + row] = 0.0;  // their multipliers stay
     lu_.solve_in_place(solution);
+    if (!pinned_rows_.empty()) check_pinned_rows(rhs, solution);
   }
 
   int rank_deficiency() const { return rank_deficiency_; }
   /// True if the last factorization pinned redundant rows (no minimum-norm projection then).
   bool multipliers_pinned() const { return !pinned_rows_.empty(); }
+  /// How many times a rank pass decided which rows to pin.
+  long pin_decisions() const { return pin_decisions_; }
   /// Factorizations that chose their pivots afresh.
   long pivoting_factorizations() const { return lu_.pivoting_factorizations(); }
 
@@ -133,9 +148,47 @@ class SparseKktSaddlePoint {
     if (row_order_.elements.empty()) row_order_ = detail::row_order(model);  // once a model
     const std::vector<char> independent =
         detail::independent_rows(row_order_, detail::sparse_jacobian(model, ws), rank_tolerance);
+    kept_pinned_rows_.swap(pinned_rows_);
+    pinned_rows_.clear();
     for (int row = 0; row < m_; ++row)
       if (!independent[row]) pinned_rows_.push_back(row);
-    if (pinned_rows_.empty()) return false;
+    pins_doubted_ = false;
+    ++pin_decisions_;
+
+    return !pinned_rows_.empty() && factorize_pinned(values);
+  }
+
+  /// Back to the rows pinned before the last decision.
+  bool restore_pinned_rows() {
+    if (kept_pinned_rows_.empty()) return false;
+    pinned_rows_.swap(kept_pinned_rows_);
+    kept_pinned_rows_.clear();
+    return true;
+  }
+
+  /// Whether the pinned rows still repeat the others: their equations, which the solve left
+  /// out, must hold with the solution it found (see BlockSchurSaddlePoint::check_pinned_rows).
+  void check_pinned_rows(const Eigen::VectorXd& rhs, const Eigen::VectorXd& solution) {
+    const std::vector<double>& values = matrix_.values();
+    const std::vector<int>& starts = matrix_.column_starts();
+    const std::vector<int>& rows = matrix_.row_indices();
+    for (const int row : pinned_rows_) pinned_products_[n_ + row] = pinned_sizes_[n_ + row] = 0.0;
+    for (int column = 0; column < n_ + m_; ++column)
+      for (int k = starts[column]; k < starts[column + 1]; ++k)
+        if (pinned_mark_[rows[k]]) {
+          pinned_products_[rows[k]] += values[k] * solution[column];
+          pinned_sizes_[rows[k]] += std::abs(values[k] * solution[column]);
+        }
+    double mismatch = 0.0, scale = rhs.tail(m_).cwiseAbs().maxCoeff();
+    for (const int row : pinned_rows_) {
+      mismatch = std::max(mismatch, std::abs(pinned_products_[n_ + row] - rhs[n_ + row]));
+      scale = std::max(scale, pinned_sizes_[n_ + row]);
+    }
+    if (mismatch > pinned_consistency * scale) pins_doubted_ = true;
+  }
+
+  /// Factorizes the matrix with the rows pinned_rows_ pinned. False if it is still singular.
+  bool factorize_pinned(const std::vector<double>& values) {
     std::vector<char>& pinned = pinned_mark_;
     pinned.assign(static_cast<std::size_t>(n_ + m_), 0);
     for (const int row : pinned_rows_) pinned[n_ + row] = 1;
@@ -159,8 +212,12 @@ class SparseKktSaddlePoint {
   Eigen::VectorXd work_;
   std::vector<int> pinned_rows_;       // rows of B that repeat others (after a singular LU)
   std::vector<double> pinned_values_;  // the matrix's values with them cleared
-  std::vector<char> pinned_mark_;      // (scratch) 1 on the pinned rows
-  detail::RowOrder row_order_;         // how to find them (built on the first need)
+  std::vector<char> pinned_mark_;      // 1 on the pinned rows
+  std::vector<int> kept_pinned_rows_;  // those pinned before the last decision
+  bool pins_doubted_ = false;          // a solve found a pinned row inconsistent
+  std::vector<double> pinned_products_, pinned_sizes_;  // (scratch) their rows times a solution
+  long pin_decisions_ = 0;                              // rank passes that decided them
+  detail::RowOrder row_order_;  // how to find them (built on the first need)
 };
 
 }  // namespace odyn
