@@ -302,6 +302,7 @@ class BlockSchurSaddlePoint {
     row_order_ = {};
     kept_pinned_rows_.clear();
     pins_doubted_ = false;
+    trusted_pivot_ratio_ = singular_pivot_ratio;
   }
 
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
@@ -623,10 +624,15 @@ class BlockSchurSaddlePoint {
   }
 
   /// Below this, a pivot of the sparse factorization relative to its diagonal entry of S
-  /// counts as zero: a row that repeats others (rounding, 1e-16 or so). Not rank_tolerance:
-  /// on a chain of slender hinged links the smallest ratio falls as N^-3 in a well-posed
-  /// model (7.5e-9 at 256 links, 1.2e-10 at 1024), and would be taken for a redundancy.
+  /// calls for the rank pass on Phi_q: a row that repeats others leaves rounding (1e-16 or
+  /// so). Not rank_tolerance: on a chain of slender hinged links the smallest ratio falls as
+  /// N^-3 in a well-posed model (7.5e-9 at 256 links, 1.2e-10 at 1024, 3e-14 on a ladder of
+  /// 5461 hinged parallelograms), and the rank pass then decides (see trust_pivots).
   static constexpr double singular_pivot_ratio = 1e-13;
+  /// What rounding leaves of a pivot for a row that repeats others.
+  static constexpr double rounding_pivot_ratio = 1e-16;
+  /// Beyond this many equations a singular S is not copied to a dense matrix (8000: 0.5 GB).
+  static constexpr int dense_fallback_limit = 8000;
 
   /// Factorizes the sparse S by CHOLMOD. When S is singular because rows of Phi_q repeat
   /// others (redundant constraints), those rows are pinned (see pin_dependent_rows) and the
@@ -644,22 +650,48 @@ class BlockSchurSaddlePoint {
     // are the fallback if the new decision leaves S singular.
     const bool pinned_before = method_ == Method::sparse_pinned;
     const bool doubted = pins_doubted_;
-    if (pinned_before && !doubted && factorize_pinned(values)) return true;
-    if (pinned_before && (pin_dependent_rows(model, ws, values) ||
-                          (doubted && restore_pinned_rows() && factorize_pinned(values))))
+    if (pinned_before && !doubted && factorize_pinned(values, false)) return true;
+    bool decided = false, none_repeat = false;  // a rank pass ran in this call; its verdict
+    const auto decide = [&] {
+      decided = true;
+      if (pin_dependent_rows(model, ws, values)) return true;
+      none_repeat = pinned_rows_.empty();
+      return false;
+    };
+    if (pinned_before &&
+        (decide() || (doubted && restore_pinned_rows() && factorize_pinned(values, false))))
       return true;
-    if (sparse_cholesky_.factorize(values) &&
-        sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio) {
+    const bool positive_definite = sparse_cholesky_.factorize(values);
+    if (positive_definite && sparse_cholesky_.smallest_pivot_ratio() > trusted_pivot_ratio_) {
       method_ = Method::sparse_cholesky;
       return true;
     }
     for (const double x : values)
       if (!std::isfinite(x)) return false;
-    if (!pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    if (!decided && decide()) return true;
+    // No row repeats others, by the rank pass: a small pivot is the conditioning of a long
+    // chain of slender links, not a redundancy (see singular_pivot_ratio).
+    if (positive_definite && none_repeat && trust_pivots()) {
+      method_ = Method::sparse_cholesky;
+      return true;
+    }
+    if (m_ > dense_fallback_limit) return false;  // O(m^2) memory: refused, not attempted
     schur_ = sparse_schur_.to_dense();
     schur_cholesky_.resize(m_);
     schur_lu_.resize(m_);
     return factorize_schur();
+  }
+
+  /// After a rank pass has decided which rows repeat others, the pivots of the factorization
+  /// of the rest are trusted down to rounding (rounding_pivot_ratio), and those of the
+  /// factorizations that follow without a rank pass down to a hundredth of the smallest one
+  /// (or singular_pivot_ratio, if higher). False if rounding explains the smallest pivot.
+  bool trust_pivots() {
+    const double ratio = sparse_cholesky_.smallest_pivot_ratio();
+    if (!(ratio > rounding_pivot_ratio)) return false;
+    trusted_pivot_ratio_ =
+        std::max(rounding_pivot_ratio, std::min(singular_pivot_ratio, 1e-2 * ratio));
+    return true;
   }
 
   /// Redundant constraints on the sparse path. The rows of Phi_q that repeat earlier ones
@@ -681,8 +713,7 @@ class BlockSchurSaddlePoint {
       if (!independent[row]) pinned_rows_.push_back(row);
     pins_doubted_ = false;
     ++pin_decisions_;
-
-    return !pinned_rows_.empty() && factorize_pinned(values);
+    return !pinned_rows_.empty() && factorize_pinned(values, true);
   }
 
   /// Back to the rows pinned before the last decision (see factorize_sparse_schur).
@@ -693,8 +724,9 @@ class BlockSchurSaddlePoint {
     return true;
   }
 
-  /// Factorizes S with the rows pinned_rows_ pinned. False if the rest is singular.
-  bool factorize_pinned(const std::vector<double>& values) {
+  /// Factorizes S with the rows pinned_rows_ pinned, just `decided` by a rank pass or kept
+  /// from before (see trust_pivots). False if the rest is singular.
+  bool factorize_pinned(const std::vector<double>& values, bool decided) {
     std::vector<char>& pinned = pinned_mark_;
     pinned.assign(static_cast<std::size_t>(m_), 0);
     for (const int row : pinned_rows_) pinned[row] = 1;
@@ -704,8 +736,9 @@ class BlockSchurSaddlePoint {
     for (int column = 0; column < m_; ++column)
       for (int k = starts[column]; k < starts[column + 1]; ++k)
         if ((pinned[rows[k]] || pinned[column]) && rows[k] != column) pinned_values_[k] = 0.0;
-    if (!sparse_cholesky_.factorize(pinned_values_) ||
-        !(sparse_cholesky_.smallest_pivot_ratio() > singular_pivot_ratio))
+    if (!sparse_cholesky_.factorize(pinned_values_)) return false;
+    if (decided ? !trust_pivots()
+                : !(sparse_cholesky_.smallest_pivot_ratio() > trusted_pivot_ratio_))
       return false;
     method_ = Method::sparse_pinned;
     rank_deficiency_ = static_cast<int>(pinned_rows_.size());
@@ -807,7 +840,8 @@ class BlockSchurSaddlePoint {
   std::vector<double> pinned_rhs_;      // (scratch) their right-hand side in a solve
   bool pins_doubted_ = false;           // a solve found a pinned row inconsistent
   long pin_decisions_ = 0;              // rank passes that decided them
-  detail::RowOrder row_order_;          // how to find them (built on the first need)
+  double trusted_pivot_ratio_ = singular_pivot_ratio;  // see trust_pivots
+  detail::RowOrder row_order_;                         // how to find them (built on the first need)
   Eigen::VectorXd work_m_, work_y_, work_qr_;
 };
 

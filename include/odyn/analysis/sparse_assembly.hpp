@@ -276,7 +276,8 @@ bool solve_sparse_saddle_point(const Blocks& diagonal_blocks, const SparseRows& 
   const std::vector<double> values(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros());
   SparseLu lu;
   lu.analyze(size, starts, row_indices);
-  if (!lu.factorize(values)) return false;
+  // The rows are independent (the rank pass chose them): only rounding counts as singular.
+  if (!lu.factorize(values, SparseLu::independent_rows_ratio)) return false;
   Eigen::VectorXd solution(size);
   solution << f, g;
   lu.solve_in_place(solution);

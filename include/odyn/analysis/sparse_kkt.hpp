@@ -85,6 +85,7 @@ class SparseKktSaddlePoint {
     pinned_rows_.clear();
     kept_pinned_rows_.clear();
     pins_doubted_ = false;
+    rows_independent_ = false;
     pinned_products_.assign(static_cast<std::size_t>(n_ + m_), 0.0);
     pinned_sizes_.assign(static_cast<std::size_t>(n_ + m_), 0.0);
     row_order_ = {};
@@ -104,15 +105,27 @@ class SparseKktSaddlePoint {
     const bool pinned_before = !pinned_rows_.empty();
     const bool doubted = pins_doubted_;
     if (pinned_before && !doubted && factorize_pinned(values)) return true;
-    if (pinned_before && (pin_dependent_rows(model, ws, values) ||
-                          (doubted && restore_pinned_rows() && factorize_pinned(values))))
+    bool decided = false;  // a rank pass ran in this call
+    const auto decide = [&] {
+      decided = true;
+      if (pin_dependent_rows(model, ws, values)) return true;
+      rows_independent_ = pinned_rows_.empty();
+      return false;
+    };
+    if (pinned_before &&
+        (decide() || (doubted && restore_pinned_rows() && factorize_pinned(values))))
       return true;
     pinned_rows_.clear();
-    if (lu_.factorize(values)) return true;
+    if (lu_.factorize(values, singular_ratio())) return true;
     for (const double x : values)
       if (!std::isfinite(x)) return false;
-    if (!pinned_before && pin_dependent_rows(model, ws, values)) return true;
+    if (!decided && decide()) return true;
     pinned_rows_.clear();
+    // No row repeats others, by the rank pass: only rounding counts as singular now (a long
+    // chain of slender links is well posed with pivots that shrink as N^-3).
+    if (rows_independent_ && lu_.factorize(values, singular_ratio())) return true;
+    rows_independent_ = false;
+    if (n_ + m_ > dense_fallback_limit) return false;  // O(n^2) memory: refused, not attempted
     minimum_norm_ = true;
     dense_.compute(matrix_.to_dense(), rank_tolerance);
     rank_deficiency_ = static_cast<int>(n_ + m_ - dense_.rank());
@@ -141,6 +154,15 @@ class SparseKktSaddlePoint {
   long pivoting_factorizations() const { return lu_.pivoting_factorizations(); }
 
  private:
+  /// Beyond this size a singular matrix is not copied to a dense one (20000: 3.2 GB).
+  static constexpr int dense_fallback_limit = 20000;
+
+  /// The singular pivots' ratio for the plain factorization: rounding only once a rank pass
+  /// has found the rows independent.
+  double singular_ratio() const {
+    return rows_independent_ ? SparseLu::independent_rows_ratio : SparseLu::singular_ratio;
+  }
+
   /// Pins the rows of B that repeat earlier ones (see the top of this file) and factorizes
   /// again. False if none repeats others or the matrix is still singular.
   bool pin_dependent_rows(const Model& model, const Workspace<Model>& ws,
@@ -198,7 +220,8 @@ class SparseKktSaddlePoint {
     for (int column = 0; column < n_ + m_; ++column)
       for (int k = starts[column]; k < starts[column + 1]; ++k)
         if (pinned[rows[k]] || pinned[column]) pinned_values_[k] = rows[k] == column ? 1.0 : 0.0;
-    if (!lu_.factorize(pinned_values_)) return false;
+    // Its rows were decided by a rank pass: only rounding counts as singular.
+    if (!lu_.factorize(pinned_values_, SparseLu::independent_rows_ratio)) return false;
     rank_deficiency_ = static_cast<int>(pinned_rows_.size());
     return true;
   }
@@ -217,7 +240,8 @@ class SparseKktSaddlePoint {
   bool pins_doubted_ = false;          // a solve found a pinned row inconsistent
   std::vector<double> pinned_products_, pinned_sizes_;  // (scratch) their rows times a solution
   long pin_decisions_ = 0;                              // rank passes that decided them
-  detail::RowOrder row_order_;  // how to find them (built on the first need)
+  bool rows_independent_ = false;  // the last rank pass found no row repeating others
+  detail::RowOrder row_order_;     // how to find them (built on the first need)
 };
 
 }  // namespace odyn
