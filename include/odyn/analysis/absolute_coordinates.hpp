@@ -9,9 +9,15 @@
 // the residual of the equations of motion and solves with the Newton matrix. Either way an
 // operation reads and writes the workspace, so that element blocks, events and observers see
 // the bodies' frames.
+//
+// Factorizations. Most integrators need one matrix at a time; BDF keeps three apart (its Newton
+// matrix, the projection's mass-constraint matrix, and one for output points), so the
+// operations that factorize or solve take a `slot`, 0 unless said otherwise, and the
+// constructor says how many slots there are.
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 
 #include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/minimum_norm.hpp"
@@ -19,6 +25,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
+#include "odyn/linalg/pivoted_lu.hpp"
 
 namespace odyn {
 
@@ -29,15 +36,19 @@ class AbsoluteCoordinates {
   /// What an implicit integrator's failure message adds: nothing here.
   static constexpr const char* newton_advice = "";
 
+  static constexpr int max_slots = 3;
+
   AbsoluteCoordinates(const Model& model, Workspace<Model>& ws,
-                      LinearSolver linear_solver = LinearSolver::automatic)
+                      LinearSolver linear_solver = LinearSolver::automatic, int slots = 1)
       : model_(model),
         ws_(ws),
         projection_(model),
         increment_(Eigen::VectorXd::Zero(model.num_velocities())),
         inverse_mass_diagonal_(Eigen::VectorXd::Zero(model.num_velocities())) {
-    solver_.choose(linear_solver);
-    solver_.analyze(model);
+    for (int slot = 0; slot < std::clamp(slots, 1, max_slots); ++slot) {
+      solvers_[slot].choose(linear_solver);
+      solvers_[slot].analyze(model);
+    }
     for (int b = 1; b <= model.num_bodies(); ++b)
       inverse_mass_diagonal_.template segment<Model::nv>((b - 1) * Model::nv) =
           model.body(BodyId{b}).mass_block().diagonal().cwiseInverse();
@@ -70,9 +81,11 @@ class AbsoluteCoordinates {
 
   void evaluate_constraints() { odyn::evaluate_constraints(model_, ws_); }
   void evaluate_forces() { odyn::evaluate_forces(model_, ws_); }
-  bool factorize() { return solver_.factorize(model_, ws_, IterationFactors{}); }
-  /// v' and lambda at the loaded state with the matrix factorized last.
-  bool solve_accelerations() { return projection_.solve_accelerations(model_, ws_, solver_); }
+  bool factorize() { return solvers_[0].factorize(model_, ws_, IterationFactors{}); }
+  /// v' and lambda at the loaded state with the matrix factorized last (in that slot).
+  bool solve_accelerations(int slot = 0) {
+    return projection_.solve_accelerations(model_, ws_, solvers_[slot]);
+  }
 
   const Eigen::VectorXd& accelerations() const { return ws_.vdot; }
   const Eigen::VectorXd& multipliers() const { return ws_.lambda; }
@@ -96,7 +109,9 @@ class AbsoluteCoordinates {
     return num_equations() > 0 ? ws_.phi.cwiseAbs().maxCoeff() : 0.0;
   }
   /// One (chord) correction towards Phi = 0, least distance in the mass metric.
-  void correct_positions() { projection_.correct_positions(model_, ws_, solver_); }
+  void correct_positions(int slot = 0) {
+    projection_.correct_positions(model_, ws_, solvers_[slot]);
+  }
   /// The part of a local error estimate e = (e_q, e_v) that outlives the projection ending the
   /// step: the corrections move along M^-1 Phi_q^T and remove what Phi_q measures, so to first
   /// order only e - M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi_q e is kept, for each part, with the
@@ -108,11 +123,11 @@ class AbsoluteCoordinates {
     for (int b = 0; b < model_.num_bodies(); ++b)
       increment_.template segment<nv>(b * nv) = Model::Space::increment_of(
           ws_.q.template segment<nq>(b * nq), error.template segment<nq>(b * nq));
-    projection_.remove_normal_part(model_, ws_, solver_, increment_);
+    projection_.remove_normal_part(model_, ws_, solvers_[0], increment_);
     for (int b = 0; b < model_.num_bodies(); ++b)
       error.template segment<nq>(b * nq) = Model::Space::configuration_rate(
           ws_.q.template segment<nq>(b * nq), increment_.template segment<nv>(b * nv));
-    projection_.remove_normal_part(model_, ws_, solver_, error.tail(num_velocities()));
+    projection_.remove_normal_part(model_, ws_, solvers_[0], error.tail(num_velocities()));
   }
 
   /// max |Phi_q v + Phi_t| at the loaded state (constraints evaluated).
@@ -122,9 +137,14 @@ class AbsoluteCoordinates {
   }
 
   /// Removes Phi_q v + Phi_t, least change in the mass metric.
-  void correct_velocities() {
+  void correct_velocities(int slot = 0) {
     projection_.velocity_residual(model_, ws_);
-    projection_.correct_velocities(model_, ws_, solver_);
+    projection_.correct_velocities(model_, ws_, solvers_[slot]);
+  }
+
+  /// Phi_q v + Phi_t at the loaded state (constraints evaluated).
+  const Eigen::VectorXd& velocity_constraint_values() {
+    return projection_.velocity_residual(model_, ws_);
   }
 
   // ---- What an implicit integrator asks for besides (see the file's comment).
@@ -143,6 +163,29 @@ class AbsoluteCoordinates {
                               to.template segment<nq>(b * nq));
   }
 
+  /// positions() = q with q = beta + c T(q) w, T the configuration rate (affine in q, so that
+  /// each body's q solves a small linear system), then normalized: the implicit position
+  /// update of a BDF step (see integrators/bdf.hpp) for the velocities w.
+  void implicit_positions(const Eigen::Ref<const Eigen::VectorXd>& beta, double c,
+                          const Eigen::VectorXd& w) {
+    constexpr int nq = Model::nq, nv = Model::nv;
+    using Configuration = Eigen::Matrix<double, nq, 1>;
+    using Velocity = Eigen::Matrix<double, nv, 1>;
+    using Square = Eigen::Matrix<double, nq, nq>;
+    for (int b = 0; b < model_.num_bodies(); ++b) {
+      const Velocity w_b = w.template segment<nv>(b * nv);
+      const Configuration offset = Model::Space::configuration_rate(Configuration::Zero(), w_b);
+      Square matrix = Square::Identity();
+      for (int i = 0; i < nq; ++i)
+        matrix.col(i) -=
+            c * (Model::Space::configuration_rate(Configuration::Unit(i), w_b) - offset);
+      const Configuration right = beta.template segment<nq>(b * nq) + c * offset;
+      auto q = ws_.q.template segment<nq>(b * nq);
+      q = solve_small<nq>(matrix, right);
+      Model::Space::normalize(q);
+    }
+  }
+
   /// M v' - Q + Phi_q^T lambda at the workspace's state (blocks and forces evaluated).
   void dynamics_residual(Eigen::Ref<Eigen::VectorXd> out) const {
     mass_times(model_, ws_.vdot, out);
@@ -154,20 +197,24 @@ class AbsoluteCoordinates {
   const Eigen::VectorXd& constraint_values() const { return ws_.phi; }
 
   /// The Newton matrix [M + damping C + stiffness K, Phi_q^T; Phi_q, 0] (see IterationFactors).
-  bool factorize(const IterationFactors& factors) {
-    return solver_.factorize(model_, ws_, factors);
+  bool factorize(const IterationFactors& factors, int slot = 0) {
+    return solvers_[slot].factorize(model_, ws_, factors);
   }
   /// x = the factorized matrix's inverse times rhs (velocities, then equations).
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) { solver_.solve(rhs, x); }
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, int slot = 0) {
+    solvers_[slot].solve(rhs, x);
+  }
   /// Equations that repeat others in the last factorization (run with minimum-norm multipliers).
-  int rank_deficiency() const { return static_cast<int>(solver_.rank_deficiency()); }
+  int rank_deficiency(int slot = 0) const {
+    return static_cast<int>(solvers_[slot].rank_deficiency());
+  }
   /// How much the geometric stiffness weighed in the last factorization (see the solver).
-  double geometric_share() const { return solver_.geometric_share(); }
+  double geometric_share() const { return solvers_[0].geometric_share(); }
   /// With redundant equations, the multipliers of least norm among those that give the same
   /// constraint forces (their reactions are then one choice among many), unless the solver
   /// pinned the redundant ones (large models).
-  void make_multipliers_unique() {
-    if (needs_minimum_norm_multipliers(solver_)) make_multipliers_minimum_norm(model_, ws_);
+  void make_multipliers_unique(int slot = 0) {
+    if (needs_minimum_norm_multipliers(solvers_[slot])) make_multipliers_minimum_norm(model_, ws_);
   }
 
   /// max |M^-1 r| by the mass matrix's diagonal: a cheap estimate of the next Newton correction
@@ -195,7 +242,7 @@ class AbsoluteCoordinates {
  private:
   const Model& model_;
   Workspace<Model>& ws_;
-  Solver solver_;
+  std::array<Solver, max_slots> solvers_;  // the slots' factorizations (see the file's comment)
   ConstraintProjection<Model> projection_;
   Eigen::VectorXd increment_;  // a position error in velocity coordinates
   Eigen::VectorXd inverse_mass_diagonal_;

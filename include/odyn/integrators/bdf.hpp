@@ -39,9 +39,8 @@
 #include <limits>
 #include <string>
 
-#include "odyn/analysis/constraint_projection.hpp"
+#include "odyn/analysis/absolute_coordinates.hpp"
 #include "odyn/analysis/diagnosis.hpp"
-#include "odyn/analysis/minimum_norm.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -70,22 +69,22 @@ struct BdfSettings {
   double max_growth = 2.0;
 };
 
-template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
-class Bdf {
+/// BDF on the coordinates of analysis/absolute_coordinates.hpp (Bdf below), through the
+/// operations that file's comment lists; three factorization slots hold its matrices.
+template <class Model, class Coordinates>
+class BdfMethod {
  public:
   using Settings = BdfSettings;
-  using Space = typename Model::Space;
-  static constexpr int nv = Model::nv;
-  static constexpr int nq = Model::nq;
   static constexpr int kMaxOrder = 5;
   static constexpr int kHistory = kMaxOrder + 2;  // past values the estimates need
 
-  Bdf(const Model& model, Workspace<Model>& ws, Settings settings = {}, StepControl control = {})
+  BdfMethod(const Model& model, Workspace<Model>& ws, Settings settings = {},
+            StepControl control = {})
       : model_(model),
         ws_(ws),
         settings_(settings),
         control_(control),
-        projection_(model),
+        coordinates_(model, ws, settings.linear_solver, 3),
         proposed_step_(std::min(control.first_step, control.max_step)) {
     if (!(control.rtol > 0.0) || !(control.atol > 0.0))
       throw ModelError("bdf", "rtol and atol must be positive, got " + to_text(control.rtol) +
@@ -101,9 +100,9 @@ class Bdf {
       throw ModelError("bdf",
                        "newton_tolerance and constraint_tolerance must be positive, "
                        "max_iterations at least 1, reuse_band at least 1 and max_growth above 1");
-    nq_total_ = model.num_coordinates();
-    nv_total_ = model.num_velocities();
-    m_ = model.num_equations();
+    nq_total_ = coordinates_.num_positions();
+    nv_total_ = coordinates_.num_velocities();
+    m_ = coordinates_.num_equations();
     ny_ = nq_total_ + nv_total_;
     const Eigen::Index size = ny_ + m_;  // history values carry lambda for the predictor
     for (auto& y : history_) y = Eigen::VectorXd::Zero(size);
@@ -114,33 +113,30 @@ class Bdf {
     scratch_ = Eigen::VectorXd::Zero(ny_);
     derivative_ = Eigen::VectorXd::Zero(ny_);
     u_ = Eigen::VectorXd::Zero(nv_total_);
+    w_ = Eigen::VectorXd::Zero(nv_total_);
+    error_scale_ = Eigen::VectorXd::Zero(nv_total_);
     dv_ = Eigen::VectorXd::Zero(nv_total_);
     du_ = Eigen::VectorXd::Zero(nv_total_);
     vdot_probe_ = Eigen::VectorXd::Zero(nv_total_);
     rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
     solution_ = rhs_;
     velocity_residual_ = Eigen::VectorXd::Zero(m_);
-    q_n_ = ws.q;
-    v_n_ = ws.v;
-    vdot_n_ = ws.vdot;
-    lambda_n_ = ws.lambda;
-    solver_.choose(settings.linear_solver);
-    output_solver_.choose(settings.linear_solver);
-    solver_.analyze(model);
-    projector_.analyze(model);
-    output_solver_.analyze(model);
-    q_trial_ = ws.q;
-    v_trial_ = ws.v;
-    vdot_trial_ = ws.vdot;
-    lambda_trial_ = ws.lambda;
+    q_n_ = coordinates_.positions();
+    v_n_ = coordinates_.velocities();
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
+    q_trial_ = q_n_;
+    v_trial_ = v_n_;
+    vdot_trial_ = vdot_n_;
+    lambda_trial_ = lambda_n_;
     initialize();
   }
 
   /// Takes the workspace's state as the committed one and starts afresh at order 1.
   void initialize() {
     t_n_ = ws_.t;
-    q_n_ = ws_.q;
-    v_n_ = ws_.v;
+    q_n_ = coordinates_.positions();
+    v_n_ = coordinates_.velocities();
     restart();
   }
 
@@ -158,10 +154,10 @@ class Bdf {
       if (solve_step(t_n_ + h)) {
         newton_failed_ = false;
         estimate_error();
-        q_trial_ = ws_.q;
-        v_trial_ = ws_.v;
-        vdot_trial_ = ws_.vdot;
-        lambda_trial_ = ws_.lambda;
+        q_trial_ = coordinates_.positions();
+        v_trial_ = coordinates_.velocities();
+        vdot_trial_ = coordinates_.accelerations();
+        lambda_trial_ = coordinates_.multipliers();
         return std::isfinite(error_);
       }
       factorized_ = false;  // a stale matrix may be the cause: once more with a fresh one
@@ -178,17 +174,15 @@ class Bdf {
   /// and lambda there (a solver of its own, so the step's factorizations stay as they are).
   bool interpolate(double t) {
     interpolate_frames(t);
-    if (!output_solver_.factorize(model_, ws_, IterationFactors{})) return false;
+    if (!coordinates_.factorize(IterationFactors{}, output)) return false;
     ++statistics_.factorizations;
     if (m_ > 0) {
       // One correction of Phi in the mass metric, then of Phi_q v + Phi_t: the interpolant is
       // off the constraints by the local error only.
-      projection_.correct_positions(model_, ws_, output_solver_);
-      projection_.velocity_residual(model_, ws_);
-      projection_.correct_velocities(model_, ws_, output_solver_);
+      coordinates_.correct_positions(output);
+      coordinates_.correct_velocities(output);
     }
-    return projection_.solve_accelerations(model_, ws_, output_solver_) && all_finite(ws_.q) &&
-           all_finite(ws_.v);
+    return coordinates_.solve_accelerations(output) && coordinates_.state_finite();
   }
 
   /// Positions and velocities at t from the last attempt's polynomial, and the frames.
@@ -209,25 +203,20 @@ class Bdf {
         scratch_ += weight * history_[j - 1].head(ny_);
       }
     }
-    ws_.t = t;
-    ws_.q = scratch_.head(nq_total_);
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Space::normalize(ws_.q.template segment<nq>(b * nq));
-    ws_.v = scratch_.tail(nv_total_);
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.load(t, scratch_);
+    coordinates_.evaluate_constraints();
   }
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
   void restore_trial() {
     ws_.t = t_n_ + h_;
-    ws_.q = q_trial_;
-    ws_.v = v_trial_;
-    ws_.vdot = vdot_trial_;
-    ws_.lambda = lambda_trial_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
+    coordinates_.positions() = q_trial_;
+    coordinates_.velocities() = v_trial_;
+    coordinates_.accelerations() = vdot_trial_;
+    coordinates_.multipliers() = lambda_trial_;
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
   }
 
   /// Commits the last attempt and chooses the next order and step (Brenan et al., Sect. 5.2).
@@ -303,15 +292,15 @@ class Bdf {
 
   /// Makes the trial state of the last attempt the committed one (no step-size change).
   void commit() {
-    if (needs_minimum_norm_multipliers(solver_)) make_multipliers_minimum_norm(model_, ws_);
+    coordinates_.make_multipliers_unique(newton);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
-    y_new_ << ws_.q, ws_.v, ws_.lambda;
+    y_new_ << coordinates_.positions(), coordinates_.velocities(), coordinates_.multipliers();
     push(y_new_, ws_.t);
     t_n_ = ws_.t;
-    q_n_ = ws_.q;
-    v_n_ = ws_.v;
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
+    q_n_ = coordinates_.positions();
+    v_n_ = coordinates_.velocities();
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
     advance_states(model_, ws_);
     ++statistics_.steps;
     ++steps_at_order_;
@@ -320,23 +309,21 @@ class Bdf {
   /// After a switch of a force law (and at the start): v' and lambda afresh at the committed
   /// state, the history reduced to it and its derivative, order 1 and a step that suits it.
   void restart() {
-    ws_.q = q_n_;
-    ws_.v = v_n_;
+    coordinates_.positions() = q_n_;
+    coordinates_.velocities() = v_n_;
     consistent_accelerations(t_n_);
-    vdot_n_ = ws_.vdot;
-    lambda_n_ = ws_.lambda;
-    rates(ws_.q, ws_.v, ws_.vdot, derivative_);
+    vdot_n_ = coordinates_.accelerations();
+    lambda_n_ = coordinates_.multipliers();
+    rates(vdot_n_, derivative_);
     // y'' by a finite difference along the motion, for the first step: order 1 leaves an error
     // of about h^2 |y''| / 2 (DASSL's estimate); aim at a quarter of the tolerance.
     const double delta = 1e-7 * std::max(1.0, std::abs(t_n_));
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      Space::integrate(q_n_.template segment<nq>(b * nq),
-                       (delta * v_n_.template segment<nv>(b * nv)).eval(),
-                       ws_.q.template segment<nq>(b * nq));
-    ws_.v = v_n_ + delta * vdot_n_;
+    w_ = delta * v_n_;
+    coordinates_.integrate(q_n_, w_, coordinates_.positions());
+    coordinates_.velocities() = v_n_ + delta * vdot_n_;
     consistent_accelerations(t_n_ + delta);
-    vdot_probe_ = ws_.vdot;
-    rates(ws_.q, ws_.v, vdot_probe_, scratch_);
+    vdot_probe_ = coordinates_.accelerations();
+    rates(vdot_probe_, scratch_);
     scratch_ = (scratch_ - derivative_) / delta;
     y_new_ << q_n_, v_n_, lambda_n_;
     const double curvature = weighted_rms_norm(scratch_, y_new_.head(ny_), y_new_.head(ny_),
@@ -365,12 +352,12 @@ class Bdf {
   /// Puts the workspace back at the last committed state.
   void rollback() {
     ws_.t = t_n_;
-    ws_.q = q_n_;
-    ws_.v = v_n_;
-    ws_.vdot = vdot_n_;
-    ws_.lambda = lambda_n_;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.positions() = q_n_;
+    coordinates_.velocities() = v_n_;
+    coordinates_.accelerations() = vdot_n_;
+    coordinates_.multipliers() = lambda_n_;
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
   }
 
   /// Rolls back and throws the SolverError that explains the last failed attempt.
@@ -401,28 +388,26 @@ class Bdf {
     count_ = std::min(count_ + 1, kHistory);
   }
 
-  /// (T(q) v, v') for every body.
-  void rates(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& vdot,
-             Eigen::VectorXd& out) const {
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      out.template segment<nq>(b * nq) =
-          Space::configuration_rate(q.template segment<nq>(b * nq), v.template segment<nv>(b * nv));
+  /// (q', v') at the coordinates' positions and velocities, for these v'.
+  void rates(const Eigen::VectorXd& vdot, Eigen::VectorXd& out) const {
+    coordinates_.position_rate(coordinates_.positions(), out.head(nq_total_));
     out.tail(nv_total_) = vdot;
   }
 
-  /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at (ws.q, ws.v, t).
+  /// v' and lambda from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the coordinates'
+  /// positions and velocities and t.
   void consistent_accelerations(double t) {
     ws_.t = t;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
     ++statistics_.residual_evaluations;
     ++statistics_.factorizations;
     factorized_ = false;  // the projector's factorization is reused here
-    if (!projector_.factorize(model_, ws_, IterationFactors{}))
+    if (!coordinates_.factorize(IterationFactors{}, projection))
       throw SolverError(t,
                         "bdf: the mass-constraint matrix is singular; check for redundant or "
                         "locked constraints");
-    projection_.solve_accelerations(model_, ws_, projector_);
+    coordinates_.solve_accelerations(projection);
   }
 
   /// Predictor weights (extrapolation through the last k+1 values) and the corrector
@@ -460,47 +445,32 @@ class Bdf {
   /// q_{n+1} from q = beta_q + c T(q) (v + u), body by body (T is affine in q), normalized; v'
   /// from the BDF formula; then frames, blocks and forces at the trial state.
   void set_state(double t_new) {
-    using Configuration = Eigen::Matrix<double, nq, 1>;
-    using Velocity = Eigen::Matrix<double, nv, 1>;
-    using Square = Eigen::Matrix<double, nq, nq>;
-    for (int b = 0; b < model_.num_bodies(); ++b) {
-      const Velocity w = ws_.v.template segment<nv>(b * nv) + u_.template segment<nv>(b * nv);
-      const Configuration offset = Space::configuration_rate(Configuration::Zero(), w);
-      Square matrix = Square::Identity();
-      for (int i = 0; i < nq; ++i)
-        matrix.col(i) -= c_ * (Space::configuration_rate(Configuration::Unit(i), w) - offset);
-      const Configuration right = beta_.template segment<nq>(b * nq) + c_ * offset;
-      auto q = ws_.q.template segment<nq>(b * nq);
-      q = solve_small<nq>(matrix, right);
-      Space::normalize(q);
-    }
-    ws_.vdot = (ws_.v - beta_.tail(nv_total_)) / c_;
+    w_ = coordinates_.velocities() + u_;
+    coordinates_.implicit_positions(beta_.head(nq_total_), c_, w_);
+    coordinates_.accelerations() = (coordinates_.velocities() - beta_.tail(nv_total_)) / c_;
     ws_.t = t_new;
     ++statistics_.residual_evaluations;
-    update_frames(model_, ws_);
-    evaluate_constraints(model_, ws_);
-    evaluate_forces(model_, ws_);
+    coordinates_.update_frames();
+    coordinates_.evaluate_constraints();
+    coordinates_.evaluate_forces();
   }
 
   /// Newton's right-hand side at the workspace's state: -[c (M v' - Q + Phi_q^T lambda);
   /// Phi_q v + Phi_t]. False if it is not finite.
   bool residuals() {
     auto dynamics = rhs_.head(nv_total_);
-    mass_times(model_, ws_.vdot, dynamics);
-    dynamics -= ws_.force;
-    add_jacobian_transpose_times(model_, ws_, ws_.lambda, dynamics);
+    coordinates_.dynamics_residual(dynamics);
     dynamics *= -c_;
-    jacobian_times(model_, ws_, ws_.v, velocity_residual_);
-    velocity_residual_ += ws_.phi_t;
+    if (m_ > 0) velocity_residual_ = coordinates_.velocity_constraint_values();
     rhs_.tail(m_) = -velocity_residual_;
-    return all_finite(rhs_) && all_finite(ws_.phi);
+    return all_finite(rhs_) && all_finite(coordinates_.constraint_values());
   }
 
   bool factorize() {
     ++statistics_.jacobian_evaluations;
     statistics_.factorizations += m_ > 0 ? 2 : 1;
-    factorized_ = solver_.factorize(model_, ws_, IterationFactors{1.0, c_ * c_, c_}) &&
-                  (m_ == 0 || projector_.factorize(model_, ws_, IterationFactors{}));
+    factorized_ = coordinates_.factorize(IterationFactors{1.0, c_ * c_, c_}, newton) &&
+                  (m_ == 0 || coordinates_.factorize(IterationFactors{}, projection));
     c_factorized_ = c_;
     rate_factor_ = 100.0;  // no convergence rate known for a new matrix (DASSL's S)
     return factorized_;
@@ -508,46 +478,44 @@ class Bdf {
 
   /// Weighted RMS size of a correction (c (dv + du) in the tangent coordinates of q, and dv),
   /// in units of the tolerance.
-  double correction_norm() const {
+  double correction_norm() {
+    coordinates_.error_scale(error_scale_);
+    const Eigen::VectorXd& v = coordinates_.velocities();
     double sum = 0.0;
-    for (int b = 0; b < model_.num_bodies(); ++b) {
-      const auto scale = Space::coordinate_scale(ws_.q.template segment<nq>(b * nq));
-      for (int i = 0; i < nv; ++i) {
-        const Eigen::Index j = b * nv + i;
-        const double dq = c_ * (dv_[j] + du_[j]) / (control_.atol + control_.rtol * scale[i]);
-        const double dv = dv_[j] / (control_.atol + control_.rtol * std::abs(ws_.v[j]));
-        sum += dq * dq + dv * dv;
-      }
+    for (Eigen::Index j = 0; j < nv_total_; ++j) {
+      const double dq = c_ * (dv_[j] + du_[j]) / (control_.atol + control_.rtol * error_scale_[j]);
+      const double dv = dv_[j] / (control_.atol + control_.rtol * std::abs(v[j]));
+      sum += dq * dq + dv * dv;
     }
     return nv_total_ > 0 ? std::sqrt(sum / static_cast<double>(2 * nv_total_)) : 0.0;
   }
 
   /// Simplified Newton from the predicted values; the workspace holds the result.
   bool solve_step(double t_new) {
-    ws_.v = predicted_.segment(nq_total_, nv_total_);
-    ws_.lambda = predicted_.tail(m_);
+    coordinates_.velocities() = predicted_.segment(nq_total_, nv_total_);
+    coordinates_.multipliers() = predicted_.tail(m_);
     u_.setZero();
     set_state(t_new);
     if (!residuals()) return false;
     if (!factorized_ && !factorize()) return false;
     double first_norm = 0.0;
     for (int k = 0; k < settings_.max_iterations; ++k) {
-      solver_.solve(rhs_, solution_);
+      coordinates_.solve(rhs_, solution_, newton);
       dv_ = solution_.head(nv_total_);
-      ws_.lambda += solution_.tail(m_) / c_;
+      coordinates_.multipliers() += solution_.tail(m_) / c_;
       if (m_ > 0) {
         // Phi_q dv = -(Phi_q v + Phi_t) holds for the matrix's Phi_q, so the rest of Phi is
         // -Phi / c + (Phi_q v + Phi_t).
         rhs_.head(nv_total_).setZero();
-        rhs_.tail(m_) = -ws_.phi / c_ + velocity_residual_;
-        projector_.solve(rhs_, solution_);
+        rhs_.tail(m_) = -coordinates_.constraint_values() / c_ + velocity_residual_;
+        coordinates_.solve(rhs_, solution_, projection);
         du_ = solution_.head(nv_total_);
       } else {
         du_.setZero();
       }
       ++statistics_.newton_iterations;
       const double norm = correction_norm();
-      ws_.v += dv_;
+      coordinates_.velocities() += dv_;
       u_ += du_;
       set_state(t_new);
       if (!residuals() || !std::isfinite(norm)) return false;
@@ -564,7 +532,8 @@ class Bdf {
         rate_factor_ = rate / (1.0 - rate);
       }
       const bool small = negligible || rate_factor_ * norm <= settings_.newton_tolerance;
-      if (small && (m_ == 0 || ws_.phi.cwiseAbs().maxCoeff() <= settings_.constraint_tolerance)) {
+      if (small && (m_ == 0 || coordinates_.constraint_values().cwiseAbs().maxCoeff() <=
+                                   settings_.constraint_tolerance)) {
         if (k + 1 > settings_.reuse_iterations) factorized_ = false;
         return true;
       }
@@ -575,9 +544,9 @@ class Bdf {
   /// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| in units of the tolerance.
   void estimate_error() {
     const int k = order_;
-    scratch_.head(nq_total_) = ws_.q - predicted_.head(nq_total_);
-    scratch_.tail(nv_total_) = ws_.v - predicted_.segment(nq_total_, nv_total_);
-    y_new_ << ws_.q, ws_.v, ws_.lambda;
+    scratch_.head(nq_total_) = coordinates_.positions() - predicted_.head(nq_total_);
+    scratch_.tail(nv_total_) = coordinates_.velocities() - predicted_.segment(nq_total_, nv_total_);
+    y_new_ << coordinates_.positions(), coordinates_.velocities(), coordinates_.multipliers();
     const double span = ws_.t - times_[k];
     error_ = (h_ / span) * weighted_rms_norm(scratch_, predicted_.head(ny_), y_new_.head(ny_),
                                              control_.rtol, control_.atol);
@@ -613,14 +582,16 @@ class Bdf {
            "). Check the force elements' parameters, or look for a locked or singular mechanism.";
   }
 
+  // The coordinates' factorization slots.
+  static constexpr int newton = 0;      // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
+  static constexpr int projection = 1;  // [M, Phi_q^T; Phi_q, 0]
+  static constexpr int output = 2;      // the same matrix at interpolated output points
+
   const Model& model_;
   Workspace<Model>& ws_;
   Settings settings_;
   StepControl control_;
-  Solver solver_;         // [M + c C + c^2 K, Phi_q^T; Phi_q, 0]
-  Solver projector_;      // [M, Phi_q^T; Phi_q, 0]
-  Solver output_solver_;  // the same matrix at interpolated output points
-  ConstraintProjection<Model> projection_;
+  Coordinates coordinates_;  // what the steps move: q, v, v' and lambda live there
   IntegratorStatistics statistics_;
   Eigen::Index nq_total_ = 0, nv_total_ = 0, m_ = 0, ny_ = 0;
   double t_n_ = 0.0, h_ = 0.0, c_ = 1.0, c_factorized_ = 1.0;
@@ -633,9 +604,15 @@ class Bdf {
   std::array<Eigen::VectorXd, kHistory> differences_;  // (q, v) divided differences
   Eigen::VectorXd predicted_, beta_, y_new_, scratch_, derivative_, vdot_probe_;
   Eigen::VectorXd u_, dv_, du_;  // u = M^-1 Phi_q^T mu and the corrections
+  Eigen::VectorXd w_;            // (scratch) v + u, or a probe's position increment
+  Eigen::VectorXd error_scale_;  // (scratch) see Coordinates::error_scale
   Eigen::VectorXd rhs_, solution_, velocity_residual_;
   Eigen::VectorXd q_n_, v_n_, vdot_n_, lambda_n_;
   Eigen::VectorXd q_trial_, v_trial_, vdot_trial_, lambda_trial_;  // the last attempt's end
 };
+
+/// BDF in absolute coordinates, with the given saddle-point solver.
+template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
+using Bdf = BdfMethod<Model, AbsoluteCoordinates<Model, Solver>>;
 
 }  // namespace odyn
