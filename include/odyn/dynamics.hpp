@@ -437,8 +437,9 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
         return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start);
       if (s.integrator == "generalized-alpha" || s.integrator == "hht")
         return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
+      if (s.integrator == "bdf") return simulate_with<JointBdf>(model, ws, s, observe, start);
       throw ModelError("dynamics",
-                       "joint coordinates run with generalized-alpha, hht, dopri5, dop853 or "
+                       "joint coordinates run with generalized-alpha, hht, bdf, dopri5, dop853 or "
                        "adams, not '" +
                            s.integrator +
                            "'; choose one of those, or coordinates 'absolute' for this "

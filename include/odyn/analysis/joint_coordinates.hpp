@@ -44,11 +44,12 @@
 // bodies' own equations, leaves first (B B^T lambda = B (Q - M v' - the constraint forces
 // already known), B the joint's block on its child; exact, since the equations are consistent).
 //
-// An implicit integrator (generalized-alpha, HHT) iterates on q, theta', theta'' and lambda in
-// place: dynamics_residual() is the recursive Newton-Euler algorithm (the same passes with
-// theta'' given), and its Newton matrix is [A C^T; C 0], factorized as above, with each body's
-// own blocks of the springs' and dampers' stiffness and damping added to its inertia (see
-// factorize(const IterationFactors&)).
+// An implicit integrator (generalized-alpha, HHT, BDF) iterates on q, theta', theta'' and
+// lambda in place: dynamics_residual() is the recursive Newton-Euler algorithm (the same passes
+// with theta'' given), and its Newton matrix is [A C^T; C 0], factorized as above, with each
+// body's own blocks of the springs' and dampers' stiffness and damping added to its inertia
+// (see factorize(const IterationFactors&)). BDF keeps three such factorizations apart (slots:
+// its Newton matrix, its projection's and its outputs').
 //
 // Limits: spatial models; loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
@@ -73,6 +74,7 @@
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/linear_solver.hpp"
+#include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/saddle_point_ldlt.hpp"
 #include "odyn/spatial/screw.hpp"
 
@@ -84,18 +86,22 @@ namespace detail {
 struct TreeNodeState {
   Eigen::Matrix<double, 6, 6> motion =
       Eigen::Matrix<double, 6, 6>::Zero();  // S: the joint's twists per unit rate (dof cols)
-  Eigen::Matrix<double, 6, 6> articulated =
-      Eigen::Matrix<double, 6, 6>::Zero();  // I^A during factorize(), then I^A - U D^-1 U^T
-  Eigen::Matrix<double, 6, 6> projected =
-      Eigen::Matrix<double, 6, 6>::Zero();  // U = I^A S (dof cols)
-  Eigen::Matrix<double, 6, 6> inverse_pivot =
-      Eigen::Matrix<double, 6, 6>::Zero();  // D^-1 = (S^T I^A S)^-1 (dof x dof)
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();  // V = (omega, v_centre)
   Eigen::Matrix<double, 6, 1> bias =
       Eigen::Matrix<double, 6, 1>::Zero();  // c: the joint's acceleration at zero theta''
   Eigen::Matrix<double, 6, 1> pivot_force =
       Eigen::Matrix<double, 6, 1>::Zero();           // u = -S^T p in a solve (dof entries)
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // r = c_child - c_parent
+};
+
+/// One tree node's part of a factorization of A (the articulated-body algorithm's).
+struct NodeFactor {
+  Eigen::Matrix<double, 6, 6> articulated =
+      Eigen::Matrix<double, 6, 6>::Zero();  // I^A during factorize(), then I^A - U D^-1 U^T
+  Eigen::Matrix<double, 6, 6> projected =
+      Eigen::Matrix<double, 6, 6>::Zero();  // U = I^A S (dof cols)
+  Eigen::Matrix<double, 6, 6> inverse_pivot =
+      Eigen::Matrix<double, 6, 6>::Zero();  // D^-1 = (S^T I^A S)^-1 (dof x dof)
 };
 
 /// One closure's Jacobian block on one body in spatial form, G = [Phi_angular R^T,
@@ -134,9 +140,13 @@ class JointCoordinates {
   /// Builds the tree at the workspace's (assembled) state and takes that state as the start.
   /// Throws ModelError if the loop closures are redundant there.
   /// (The closures' Schur complement is small and dense: `linear_solver` is not used.)
+  /// Factorizations kept apart (see AbsoluteCoordinates): BDF's Newton matrix, its
+  /// projection's and its outputs'. The operations without a slot use the one used last.
+  static constexpr int max_slots = 3;
+
   JointCoordinates(const Model& model, Workspace<Model>& ws,
-                   LinearSolver /*linear_solver*/ = LinearSolver::automatic)
-      : model_(model), ws_(ws) {
+                   LinearSolver /*linear_solver*/ = LinearSolver::automatic, int slots = 1)
+      : model_(model), ws_(ws), slots_(std::clamp(slots, 1, max_slots)) {
     odyn::update_frames(model, ws);
     build_tree();
     size_buffers();
@@ -211,7 +221,7 @@ class JointCoordinates {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const auto& body = model_.body(BodyId{tree_[i].body});
       const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
-      Matrix6& inertia = nodes_[i].articulated;
+      Matrix6& inertia = factor(i).articulated;
       inertia.setZero();
       inertia.topLeftCorner<3, 3>().noalias() = rotation * body.inertia * rotation.transpose();
       inertia.bottomRightCorner<3, 3>().diagonal().setConstant(body.mass);
@@ -236,11 +246,15 @@ class JointCoordinates {
       tree_solve(false, increment_, motion_);
       closure_rates(motion_, schur_.col(j));
     }
-    schur_llt_.compute(schur_);
-    return schur_llt_.info() == Eigen::Success;
+    schur_llts_[slot_].compute(schur_);
+    return schur_llts_[slot_].info() == Eigen::Success;
   }
 
   /// theta'' and the closures' lambda at the loaded state, with the matrix factorized last.
+  bool solve_accelerations(int slot) {
+    slot_ = slot;
+    return solve_accelerations();
+  }
   bool solve_accelerations() {
     odyn::evaluate_forces(model_, ws_);
     // Each body's bias force: its velocity terms (m omega x v_centre in spatial form at the
@@ -293,6 +307,10 @@ class JointCoordinates {
 
   /// One (chord) correction towards the closures' Phi = 0, least distance in A:
   /// [A C^T; C 0] [dx; mu] = [0; -Phi].
+  void correct_positions(int slot) {
+    slot_ = slot;
+    correct_positions();
+  }
   void correct_positions() {
     closure_rhs_ = -phi_;
     saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
@@ -341,6 +359,10 @@ class JointCoordinates {
   }
 
   /// Removes C theta' + Phi_t, least change in A.
+  void correct_velocities(int slot) {
+    slot_ = slot;
+    correct_velocities();
+  }
   void correct_velocities() {
     closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);
     closure_rhs_ = -(closure_rhs_ + phi_t_);
@@ -413,6 +435,50 @@ class JointCoordinates {
   /// The closures' Phi at the loaded positions (constraints evaluated).
   const Eigen::VectorXd& constraint_values() const { return phi_; }
 
+  /// C theta' + Phi_t at the loaded state (constraints evaluated).
+  const Eigen::VectorXd& velocity_constraint_values() {
+    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, velocity_values_);
+    velocity_values_ += phi_t_;
+    return velocity_values_;
+  }
+
+  /// positions() = q with q = beta + c T(q) w (T the coordinates' rate, affine in q: each
+  /// joint's q solves a small linear system), quaternions normalized: BDF's implicit position
+  /// update (see integrators/bdf.hpp) for the rates w.
+  void implicit_positions(const Eigen::Ref<const Eigen::VectorXd>& beta, double c,
+                          const Eigen::VectorXd& w) {
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free) {
+        using Configuration = Eigen::Matrix<double, Spatial::nq, 1>;
+        using Square = Eigen::Matrix<double, Spatial::nq, Spatial::nq>;
+        const Eigen::Matrix<double, Spatial::nv, 1> rate = w.segment<Spatial::nv>(node.v_offset);
+        const Configuration offset = Spatial::configuration_rate(Configuration::Zero(), rate);
+        Square matrix = Square::Identity();
+        for (int i = 0; i < Spatial::nq; ++i)
+          matrix.col(i) -= c * (Spatial::configuration_rate(Configuration::Unit(i), rate) - offset);
+        auto q = q_.segment<Spatial::nq>(node.q_offset);
+        q = solve_small<Spatial::nq>(
+            matrix, Configuration(beta.segment<Spatial::nq>(node.q_offset) + c * offset));
+        Spatial::normalize(q);
+      } else if (node.kind == Kind::ball) {
+        // q' = q (0, w) / 2 = R(w) q: (1 - c R(w)) q = beta.
+        const Eigen::Vector3d rate = w.segment<3>(node.v_offset);
+        Eigen::Matrix4d matrix;
+        matrix << 0.0, -rate[0], -rate[1], -rate[2],  //
+            rate[0], 0.0, rate[2], -rate[1],          //
+            rate[1], -rate[2], 0.0, rate[0],          //
+            rate[2], rate[1], -rate[0], 0.0;
+        matrix = Eigen::Matrix4d::Identity() - (0.5 * c) * matrix;
+        auto q = q_.segment<4>(node.q_offset);
+        q = solve_small<4>(matrix, Eigen::Vector4d(beta.segment<4>(node.q_offset)));
+        q.normalize();
+      } else {
+        q_.segment(node.q_offset, node.dof()) =
+            beta.segment(node.q_offset, node.dof()) + c * w.segment(node.v_offset, node.dof());
+      }
+    }
+  }
+
   /// The Newton matrix of an implicit integrator: [A C^T; C 0] with A the mass matrix in joint
   /// coordinates plus J^T (stiffness K + damping C) J, where K and C keep only each body's own
   /// blocks of the force elements' stiffness and damping (and of its gyroscopic terms), their
@@ -420,7 +486,8 @@ class JointCoordinates {
   /// them out keeps A's recursive factorization. The derivatives of A itself and of the
   /// velocity terms of the tree are left out too: a modified Newton iteration, which converges
   /// wherever the mass over h^2 and the bodies' own blocks outweigh what it leaves out.
-  bool factorize(const IterationFactors& factors) {
+  bool factorize(const IterationFactors& factors, int slot = 0) {
+    slot_ = slot;
     if (factors.stiffness == 0.0 && factors.damping == 0.0) return factorize();
     load_inertias();
     add_own_force_blocks(factors.stiffness, factors.damping);
@@ -429,7 +496,8 @@ class JointCoordinates {
   }
 
   /// x = [A C^T; C 0]^-1 rhs with the last factorization (rates, then closure equations).
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, int slot = 0) {
+    slot_ = slot;
     const Eigen::Index n = num_velocities(), m = num_equations();
     joint_rhs_ = rhs.head(n);
     closure_rhs_ = rhs.tail(m);
@@ -439,9 +507,9 @@ class JointCoordinates {
 
   // Redundant closures are refused at the start (check_closures), and the matrix leaves out
   // the geometric stiffness.
-  int rank_deficiency() const { return 0; }
+  int rank_deficiency(int /*slot*/ = 0) const { return 0; }
   double geometric_share() const { return 0.0; }
-  void make_multipliers_unique() {}
+  void make_multipliers_unique(int /*slot*/ = 0) {}
 
   /// max |A^-1 r|, one solve along the tree (the closures left out): the next Newton
   /// correction of theta'' for the residual r, about.
@@ -663,7 +731,7 @@ class JointCoordinates {
       const Block symmetric = 0.5 * (own_blocks_[b] + own_blocks_[b].transpose());
       const Eigen::Matrix3d& rotation = ws_.frames[b].rotation;
       // B = [B_vv B_vw; B_wv B_ww] in (v, omega_body); spatial (omega, v): T^T B T.
-      Matrix6& inertia = nodes_[i].articulated;
+      Matrix6& inertia = factor(i).articulated;
       inertia.topLeftCorner<3, 3>().noalias() +=
           rotation * symmetric.bottomRightCorner<3, 3>() * rotation.transpose();
       const Eigen::Matrix3d coupling = rotation * symmetric.bottomLeftCorner<3, 3>();
@@ -673,24 +741,28 @@ class JointCoordinates {
     }
   }
 
+  /// Node i's part of the factorization in the current slot.
+  detail::NodeFactor& factor(std::size_t i) { return factors_[slot_][i]; }
+
   /// ABA's inertia step for node i: U, D^-1, I^A - U D^-1 U^T, which the parent inherits
   /// shifted to its centre: X^T I X, X = [1 0; -[r] 1], r = c_child - c_parent.
   template <int K>
   bool factor_node(std::size_t i) {
-    detail::TreeNodeState& node = nodes_[i];
+    const detail::TreeNodeState& node = nodes_[i];
+    detail::NodeFactor& own = factor(i);
     if constexpr (K > 0) {
       const auto motion = node.motion.template leftCols<K>();
-      auto projected = node.projected.template leftCols<K>();
-      projected.noalias() = node.articulated * motion;
+      auto projected = own.projected.template leftCols<K>();
+      projected.noalias() = own.articulated * motion;
       const Eigen::Matrix<double, K, K> pivot = motion.transpose() * projected;
       const Eigen::LLT<Eigen::Matrix<double, K, K>> llt(pivot);
       if (llt.info() != Eigen::Success) return false;
-      auto inverse = node.inverse_pivot.template topLeftCorner<K, K>();
+      auto inverse = own.inverse_pivot.template topLeftCorner<K, K>();
       inverse = llt.solve(Eigen::Matrix<double, K, K>::Identity());
-      node.articulated.noalias() -= projected * (inverse * projected.transpose());
+      own.articulated.noalias() -= projected * (inverse * projected.transpose());
     }
     const int parent = tree_[i].parent_node;
-    if (parent >= 0) add_shifted_inertia(node.articulated, node.offset, nodes_[parent].articulated);
+    if (parent >= 0) add_shifted_inertia(own.articulated, node.offset, factor(parent).articulated);
     return true;
   }
 
@@ -717,8 +789,8 @@ class JointCoordinates {
     const Eigen::Index n = num_velocities();
     for (std::size_t i = tree_.size(); i-- > 0;)
       if (tree_[i].parent_node >= 0)
-        add_shifted_inertia(nodes_[i].articulated, nodes_[i].offset,
-                            nodes_[tree_[i].parent_node].articulated);
+        add_shifted_inertia(factor(i).articulated, nodes_[i].offset,
+                            factor(tree_[i].parent_node).articulated);
     kkt_.setZero();
     // Entries one 6-vector product at a time: at these sizes, Eigen's products of blocks of
     // run-time size cost more in their set-up than in their arithmetic.
@@ -732,7 +804,7 @@ class JointCoordinates {
       if (dof == 0) continue;
       std::array<Vector6, 6> momentum;  // I^c S, carried up the tree
       for (int k = 0; k < dof; ++k)
-        momentum[k].noalias() = nodes_[i].articulated * nodes_[i].motion.col(k);
+        momentum[k].noalias() = factor(i).articulated * nodes_[i].motion.col(k);
       fill(momentum.data(), dof, tree_[i].v_offset, nodes_[i].motion, dof, tree_[i].v_offset);
       for (int j = static_cast<int>(i); tree_[j].parent_node >= 0;) {
         for (int k = 0; k < dof; ++k)
@@ -754,7 +826,7 @@ class JointCoordinates {
           rows[r].head<3>() += nodes_[j].offset.cross(rows[r].tail<3>());
       }
     }
-    return kkt_ldlt_.compute(kkt_);
+    return kkt_ldlts_[slot_].compute(kkt_);
   }
 
   /// ABA's force step for node i: u = -S^T p, and the force the subtree hands its parent,
@@ -762,14 +834,15 @@ class JointCoordinates {
   template <int K>
   bool backward_node(std::size_t i, bool with_bias, const Eigen::VectorXd* joint_force) {
     detail::TreeNodeState& node = nodes_[i];
+    const detail::NodeFactor& own = factor(i);
     Vector6 handed = force_[i];
-    if (with_bias) handed.noalias() += node.articulated * node.bias;
+    if (with_bias) handed.noalias() += own.articulated * node.bias;
     if constexpr (K > 0) {
       auto u = node.pivot_force.template head<K>();
       u.noalias() = -(node.motion.template leftCols<K>().transpose() * force_[i]);
       if (joint_force) u += joint_force->segment<K>(tree_[i].v_offset);
-      handed.noalias() += node.projected.template leftCols<K>() *
-                          (node.inverse_pivot.template topLeftCorner<K, K>() * u);
+      handed.noalias() += own.projected.template leftCols<K>() *
+                          (own.inverse_pivot.template topLeftCorner<K, K>() * u);
     }
     const int parent = tree_[i].parent_node;
     if (parent >= 0) add_shifted_force(handed, node.offset, force_[parent]);
@@ -787,9 +860,10 @@ class JointCoordinates {
     if (with_bias) a += node.bias;
     if constexpr (K > 0) {
       auto theta = x.segment<K>(tree_[i].v_offset);
-      theta.noalias() = node.inverse_pivot.template topLeftCorner<K, K>() *
+      const detail::NodeFactor& own = factor(i);
+      theta.noalias() = own.inverse_pivot.template topLeftCorner<K, K>() *
                         (node.pivot_force.template head<K>() -
-                         node.projected.template leftCols<K>().transpose() * a);
+                         own.projected.template leftCols<K>().transpose() * a);
       a.noalias() += node.motion.template leftCols<K>() * theta;
     }
     acceleration[i] = a;
@@ -826,8 +900,8 @@ class JointCoordinates {
     closure_rates(motion_, mu);
     mu -= s;
     // By the triangular factors: LLT's own solveInPlace copies a Ref into a new vector.
-    schur_llt_.matrixL().solveInPlace(mu);
-    schur_llt_.matrixU().solveInPlace(mu);
+    schur_llts_[slot_].matrixL().solveInPlace(mu);
+    schur_llts_[slot_].matrixU().solveInPlace(mu);
     clear(force_);
     add_closure_wrenches(mu, 1.0, force_);  // p = -(-C^T mu)
     tree_solve(false, closure_step_, closure_motion_);
@@ -869,7 +943,7 @@ class JointCoordinates {
     } else {
       solution_.head(n).setZero();
     }
-    kkt_ldlt_.solve_in_place(solution_);
+    kkt_ldlts_[slot_].solve_in_place(solution_);
     x = solution_.head(n);
     mu = solution_.tail(num_equations());
   }
@@ -1042,6 +1116,8 @@ class JointCoordinates {
   void size_buffers() {
     const Eigen::Index n = num_velocities(), m = num_equations();
     nodes_.assign(tree_.size(), detail::TreeNodeState{});
+    for (int slot = 0; slot < slots_; ++slot)
+      factors_[slot].assign(tree_.size(), detail::NodeFactor{});
     own_blocks_.assign(static_cast<std::size_t>(model_.num_bodies() + 1),
                        Spatial::MassBlock::Zero());
     force_.assign(tree_.size(), Vector6::Zero());
@@ -1050,17 +1126,19 @@ class JointCoordinates {
     closure_motion_ = force_;
     constraint_force_.setZero(6 * model_.num_bodies());
     phi_t_.setZero(m);
+    velocity_values_.setZero(m);
     lambda_.setZero(m);
     multiplier_.setZero(m);
     closure_rhs_.setZero(m);
     dense_ = n + m <= dense_limit;
     if (dense_) {
       kkt_.setZero(n + m, n + m);
-      kkt_ldlt_.resize(n, m);
+      for (int slot = 0; slot < slots_; ++slot) kkt_ldlts_[slot].resize(n, m);
       solution_.setZero(n + m);
     } else {
       schur_.setZero(m, m);
-      schur_llt_.compute(Eigen::MatrixXd::Identity(m, m));  // sizes its storage once
+      for (int slot = 0; slot < slots_; ++slot)  // sizes their storage once
+        schur_llts_[slot].compute(Eigen::MatrixXd::Identity(m, m));
     }
     qdd_.setZero(n);
     increment_.setZero(n);
@@ -1307,14 +1385,17 @@ class JointCoordinates {
   Eigen::VectorXd q_, v_;             // (nq), (n) joint coordinates and rates
   Eigen::VectorXd constraint_force_;  // (6 nb) Phi_q^T lambda, in complete_workspace()
   Eigen::VectorXd phi_, phi_t_;       // (m) of the closures
+  Eigen::VectorXd velocity_values_;   // (m) C theta' + Phi_t
   Eigen::VectorXd closure_rhs_;       // (m) a saddle-point solve's s
   Eigen::VectorXd multiplier_;        // (m) scratch
   Eigen::MatrixXd schur_;             // (m x m) C A^-1 C^T
   bool dense_ = false;                // small: the whole saddle-point matrix (dense_limit)
   Eigen::MatrixXd kkt_;               // (n + m) [A C^T; C 0], lower triangle (dense_)
-  SaddlePointLdlt kkt_ldlt_;
+  std::array<SaddlePointLdlt, max_slots> kkt_ldlts_;  // its factorization, per slot
   Eigen::VectorXd solution_;  // (n + m) right-hand side, then solution (dense_)
-  Eigen::LLT<Eigen::MatrixXd> schur_llt_;
+  std::array<Eigen::LLT<Eigen::MatrixXd>, max_slots> schur_llts_;   // the Schur's, per slot
+  std::array<std::vector<detail::NodeFactor>, max_slots> factors_;  // A's, per slot and node
+  int slots_ = 1, slot_ = 0;  // the slots in use; the one factorized or solved with last
   Eigen::VectorXd increment_, increment2_;  // (n) scratch
   Eigen::VectorXd closure_step_;            // (n) saddle_solve's own scratch
   Eigen::VectorXd joint_rhs_, estimate_;    // (n) an implicit integrator's solves (scratch)

@@ -41,6 +41,7 @@
 
 #include "odyn/analysis/absolute_coordinates.hpp"
 #include "odyn/analysis/diagnosis.hpp"
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -206,6 +207,11 @@ class BdfMethod {
     coordinates_.load(t, scratch_);
     coordinates_.evaluate_constraints();
   }
+
+  /// In joint coordinates, fills in the workspace at an output as an absolute-coordinate run
+  /// leaves it (see JointCoordinates::complete_workspace).
+  void refresh_blocks() requires requires(Coordinates& c) { c.complete_workspace(); }
+  { coordinates_.complete_workspace(); }
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
   void restore_trial() {
@@ -614,5 +620,9 @@ class BdfMethod {
 /// BDF in absolute coordinates, with the given saddle-point solver.
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
 using Bdf = BdfMethod<Model, AbsoluteCoordinates<Model, Solver>>;
+
+/// BDF in joint coordinates (analysis/joint_coordinates.hpp).
+template <class Model>
+using JointBdf = BdfMethod<Model, JointCoordinates<Model>>;
 
 }  // namespace odyn
