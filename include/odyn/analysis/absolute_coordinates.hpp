@@ -23,9 +23,9 @@
 #include "odyn/analysis/minimum_norm.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/core/implicit_configuration.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
-#include "odyn/linalg/pivoted_lu.hpp"
 
 namespace odyn {
 
@@ -169,21 +169,11 @@ class AbsoluteCoordinates {
   void implicit_positions(const Eigen::Ref<const Eigen::VectorXd>& beta, double c,
                           const Eigen::VectorXd& w) {
     constexpr int nq = Model::nq, nv = Model::nv;
-    using Configuration = Eigen::Matrix<double, nq, 1>;
-    using Velocity = Eigen::Matrix<double, nv, 1>;
-    using Square = Eigen::Matrix<double, nq, nq>;
-    for (int b = 0; b < model_.num_bodies(); ++b) {
-      const Velocity w_b = w.template segment<nv>(b * nv);
-      const Configuration offset = Model::Space::configuration_rate(Configuration::Zero(), w_b);
-      Square matrix = Square::Identity();
-      for (int i = 0; i < nq; ++i)
-        matrix.col(i) -=
-            c * (Model::Space::configuration_rate(Configuration::Unit(i), w_b) - offset);
-      const Configuration right = beta.template segment<nq>(b * nq) + c * offset;
-      auto q = ws_.q.template segment<nq>(b * nq);
-      q = solve_small<nq>(matrix, right);
-      Model::Space::normalize(q);
-    }
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      implicit_configuration<typename Model::Space>(
+          beta.template segment<nq>(b * nq), c,
+          Eigen::Matrix<double, nv, 1>(w.template segment<nv>(b * nv)),
+          ws_.q.template segment<nq>(b * nq));
   }
 
   /// M v' - Q + Phi_q^T lambda at the workspace's state (blocks and forces evaluated).

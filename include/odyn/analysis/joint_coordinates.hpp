@@ -69,6 +69,7 @@
 #include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/core/implicit_configuration.hpp"
 #include "odyn/core/rotation.hpp"
 #include "odyn/core/spatial.hpp"
 #include "odyn/core/workspace.hpp"
@@ -449,17 +450,10 @@ class JointCoordinates {
                           const Eigen::VectorXd& w) {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        using Configuration = Eigen::Matrix<double, Spatial::nq, 1>;
-        using Square = Eigen::Matrix<double, Spatial::nq, Spatial::nq>;
-        const Eigen::Matrix<double, Spatial::nv, 1> rate = w.segment<Spatial::nv>(node.v_offset);
-        const Configuration offset = Spatial::configuration_rate(Configuration::Zero(), rate);
-        Square matrix = Square::Identity();
-        for (int i = 0; i < Spatial::nq; ++i)
-          matrix.col(i) -= c * (Spatial::configuration_rate(Configuration::Unit(i), rate) - offset);
-        auto q = q_.segment<Spatial::nq>(node.q_offset);
-        q = solve_small<Spatial::nq>(
-            matrix, Configuration(beta.segment<Spatial::nq>(node.q_offset) + c * offset));
-        Spatial::normalize(q);
+        implicit_configuration<Spatial>(
+            beta.segment<Spatial::nq>(node.q_offset), c,
+            Eigen::Matrix<double, Spatial::nv, 1>(w.segment<Spatial::nv>(node.v_offset)),
+            q_.segment<Spatial::nq>(node.q_offset));
       } else if (node.kind == Kind::ball) {
         // q' = q (0, w) / 2 = R(w) q: (1 - c R(w)) q = beta.
         const Eigen::Vector3d rate = w.segment<3>(node.v_offset);
