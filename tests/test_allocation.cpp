@@ -121,13 +121,15 @@ TEST_CASE("an Adams step allocates nothing, in absolute and in joint coordinates
   check_engine_run<odyn::JointAdamsBashforth<engine::Model>>({.order = 5}, {});
 }
 
-TEST_CASE("a generalized-alpha step allocates nothing in joint coordinates", "[workspace][joint]") {
+TEST_CASE("generalized-alpha and BDF steps allocate nothing in joint coordinates",
+          "[workspace][joint]") {
   check_engine_run<odyn::JointGeneralizedAlpha<engine::Model>>({}, {});
+  check_engine_run<odyn::JointBdf<engine::Model>>({}, {.rtol = 1e-8, .atol = 1e-8});
 }
 
 TEST_CASE(
-    "dop853 and generalized-alpha steps allocate nothing in joint coordinates' recursive "
-    "passes",
+    "dop853, generalized-alpha and BDF steps allocate nothing in joint coordinates' "
+    "recursive passes",
     "[workspace][dop853][joint]") {
   // Ten ball-jointed links, the last tied back to the ground by a distance: 30 rates and one
   // closure, above the size at which the whole saddle-point matrix is formed.
@@ -163,6 +165,7 @@ TEST_CASE(
   };
   check(static_cast<odyn::JointDormandPrince853<Model>*>(nullptr));
   check(static_cast<odyn::JointGeneralizedAlpha<Model>*>(nullptr));
+  check(static_cast<odyn::JointBdf<Model>*>(nullptr));
 }
 
 TEST_CASE("a time step allocates nothing on the sparse paths (CHOLMOD's Schur complement, KLU)",
