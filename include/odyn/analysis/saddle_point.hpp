@@ -769,7 +769,7 @@ class BlockSchurSaddlePoint {
     double mismatch = 0.0, scale = rhs_scale;
     for (std::size_t i = 0; i < pinned_rows_.size(); ++i) {
       mismatch = std::max(mismatch, std::abs(work_qr_[pinned_rows_[i]] - pinned_rhs_[i]));
-      scale = std::max(scale, work_y_[pinned_rows_[i]]);
+      scale = std::max({scale, work_y_[pinned_rows_[i]], std::abs(pinned_rhs_[i])});
     }
     if (mismatch > pinned_consistency * scale) pins_doubted_ = true;
   }

@@ -21,6 +21,8 @@
 // to a dense complete orthogonal decomposition, O((n + m)^3).
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "odyn/analysis/sparse_assembly.hpp"
@@ -31,14 +33,14 @@
 
 namespace odyn {
 
-/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block, and whether the
-/// stiffness term also holds the constraints' geometric stiffness G = d(Phi_q^T lambda)/dq
-/// (see add_geometric_stiffness).
 /// Above this, relative to the size of its terms, a pinned row's equation left unsolved by a
 /// solve says that the row no longer repeats others (see check_pinned_rows): at a Newton
 /// iterate a repeated row holds to about the distance from the constraint manifold.
 inline constexpr double pinned_consistency = 1e-6;
 
+/// Multipliers of M, K = -dQ/dq and C = -dQ/dv in the top-left block, and whether the
+/// stiffness term also holds the constraints' geometric stiffness G = d(Phi_q^T lambda)/dq
+/// (see add_geometric_stiffness).
 struct IterationFactors {
   double mass = 1.0;
   double stiffness = 0.0;
@@ -176,7 +178,6 @@ class SparseKktSaddlePoint {
       if (!independent[row]) pinned_rows_.push_back(row);
     pins_doubted_ = false;
     ++pin_decisions_;
-
     return !pinned_rows_.empty() && factorize_pinned(values);
   }
 
@@ -204,7 +205,7 @@ class SparseKktSaddlePoint {
     double mismatch = 0.0, scale = rhs.tail(m_).cwiseAbs().maxCoeff();
     for (const int row : pinned_rows_) {
       mismatch = std::max(mismatch, std::abs(pinned_products_[n_ + row] - rhs[n_ + row]));
-      scale = std::max(scale, pinned_sizes_[n_ + row]);
+      scale = std::max({scale, pinned_sizes_[n_ + row], std::abs(rhs[n_ + row])});
     }
     if (mismatch > pinned_consistency * scale) pins_doubted_ = true;
   }
