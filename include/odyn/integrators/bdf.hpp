@@ -70,8 +70,9 @@ struct BdfSettings {
   double max_growth = 2.0;
 };
 
-/// BDF on the coordinates of analysis/absolute_coordinates.hpp (Bdf below), through the
-/// operations that file's comment lists; three factorization slots hold its matrices.
+/// BDF on a coordinates object, through the operations analysis/absolute_coordinates.hpp lists
+/// (Bdf below in absolute coordinates, JointBdf in joint ones); three factorization slots hold
+/// its matrices.
 template <class Model, class Coordinates>
 class BdfMethod {
  public:
