@@ -712,16 +712,16 @@ TEST_CASE("A long hinged chain, whose pivots shrink as N^-3, assembles and falls
   HingedModel model;
   odyn::BodyId previous = odyn::ground;
   for (int i = 0; i < links; ++i) {
-    const odyn::BodyId body = model.add_body(
-        sp::Body{.name = "link" + std::to_string(i),
-                 .mass = 1.0,
-                 .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
-                 .position = {0.5 + i, 0.0, 0.0}});
-    model.add(sp::Revolute(
-        "hinge" + std::to_string(i), previous,
-        sp::JointFrame{previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0),
-                       Vector3d::UnitY()},
-        body, sp::JointFrame{Vector3d(-0.5, 0, 0), Vector3d::UnitY()}));
+    const odyn::BodyId body =
+        model.add_body(sp::Body{.name = "link" + std::to_string(i),
+                                .mass = 1.0,
+                                .inertia = sp::Body::principal(5e-5, 1.0 / 12.0, 1.0 / 12.0),
+                                .position = {0.5 + i, 0.0, 0.0}});
+    model.add(
+        sp::Revolute("hinge" + std::to_string(i), previous,
+                     sp::JointFrame{previous.is_ground() ? Vector3d::Zero() : Vector3d(0.5, 0, 0),
+                                    Vector3d::UnitY()},
+                     body, sp::JointFrame{Vector3d(-0.5, 0, 0), Vector3d::UnitY()}));
     previous = body;
   }
   model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
