@@ -26,6 +26,8 @@
 // closures, the articulated-body factorization and solve), and setup_s the assembly plus the
 // tree's construction. spherical-chain-joint-alpha and spherical-chain-moving-joint-alpha step
 // the two chains with generalized-alpha in joint coordinates (step_s a step, as above).
+// planar-revolute-chain and planar-revolute-chain-joint: revolute-chain as a planar model (the
+// same motion, in the x-z plane), in absolute and joint coordinates.
 // setup_s: assembly (positions, the given velocities, accelerations) plus the integrator's
 // analysis, wall time. step_s: the median over 5 blocks of steps of the wall time per step
 // (per h of simulated time where a step that failed to converge was cut, as in simulate()).
@@ -171,6 +173,27 @@ Model four_bar_ladder(int n, bool hinged = false) {
   return model;
 }
 
+namespace pl = odyn::planar;
+using PlanarModel = pl::Model<pl::Revolute, pl::Gravity>;
+
+/// revolute-chain's links in the plane: hinged end to end along x, gravity along -y.
+PlanarModel planar_chain(int n) {
+  PlanarModel model;
+  odyn::BodyId previous = odyn::ground;
+  for (int i = 0; i < n; ++i) {
+    const odyn::BodyId body = model.add_body(pl::Body{.name = "link" + std::to_string(i),
+                                                      .mass = 1.0,
+                                                      .inertia = 1.0 / 12.0,
+                                                      .position = {0.5 + i, 0.0}});
+    const Eigen::Vector2d on_previous(previous.is_ground() ? 0.0 : 0.5, 0.0);
+    model.add(pl::Revolute("joint" + std::to_string(i), previous, {on_previous}, body,
+                           {Eigen::Vector2d(-0.5, 0.0)}));
+    previous = body;
+  }
+  model.add(pl::Gravity("gravity", {0.0, -9.81}));
+  return model;
+}
+
 struct Row {
   std::string name;
   int bodies = 0, equations = 0;
@@ -207,7 +230,7 @@ double median_time(Work&& work, long& calls) {
 
 /// The model with generalized-alpha at h = step (absolute coordinates, or joint coordinates
 /// with JointGeneralizedAlpha): setup (assembly and the integrator) and the time per step.
-template <class Integrator = odyn::GeneralizedAlpha<Model>>
+template <class Integrator, class Model>
 Row measure(const std::string& name, const Model& model) {
   Row row;
   row.name = name;
@@ -241,6 +264,7 @@ Row measure(const std::string& name, const Model& model) {
 
 /// The model in joint coordinates: setup (assembly and the tree) and one forward-dynamics
 /// evaluation at the start, as each stage of an explicit integrator makes it.
+template <class Model>
 Row measure_joint(const std::string& name, const Model& model) {
   Row row;
   row.name = name;
@@ -313,23 +337,27 @@ int main(int argc, char** argv) {
       {"spherical-chain-moving-joint-alpha",
        [](int n) { return chain(n, Joint::ball, false, true); }},
   };
+  const std::vector<std::pair<std::string, std::function<PlanarModel(int)>>> planar_cases = {
+      {"planar-revolute-chain", planar_chain},
+      {"planar-revolute-chain-joint", planar_chain},
+  };
   std::ofstream csv(out);
   csv << "case,N,equations,setup_s,assembly_s,step_s,steps,newton_per_step,"
          "factorizations_per_step,peak_rss_mb,status\n";
   std::printf("%-24s %6s %7s %10s %10s %10s %6s %6s %8s  %s\n", "case", "N", "eqs", "setup ms",
               "assem ms", "step ms", "newton", "facts", "RSS MB", "status");
-  for (const auto& [name, build] : cases) {
-    if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
+  const auto run = [&]<class M>(const std::string& name, const std::function<M(int)>& build) {
+    if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) return;
     for (int n = 1; n <= max_n; n *= 2) {
       if (n < min_n) continue;
       const bool ladder = name.starts_with("four-bar-ladder");
       const bool joint = name.ends_with("-joint");
       if (ladder && (n < 3 || (joint && n > 256))) continue;
-      const Model model = build(ladder ? 3 * std::max(1, n / 3) : n);
+      const M model = build(ladder ? 3 * std::max(1, n / 3) : n);
       const Row row = joint ? measure_joint(name, model)
                       : name.ends_with("-alpha")
-                          ? measure<odyn::JointGeneralizedAlpha<Model>>(name, model)
-                          : measure(name, model);
+                          ? measure<odyn::JointGeneralizedAlpha<M>>(name, model)
+                          : measure<odyn::GeneralizedAlpha<M>>(name, model);
       csv << row.name << ',' << row.bodies << ',' << row.equations << ',' << row.setup_s << ','
           << row.assembly_s << ',' << row.step_s << ',' << row.steps << ',' << row.newton_per_step
           << ',' << row.factorizations_per_step << ',' << row.peak_rss_mb << ',' << row.status
@@ -341,5 +369,7 @@ int main(int argc, char** argv) {
                   row.peak_rss_mb, row.status.c_str());
       std::fflush(stdout);
     }
-  }
+  };
+  for (const auto& [name, build] : cases) run(name, build);
+  for (const auto& [name, build] : planar_cases) run(name, build);
 }

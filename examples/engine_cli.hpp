@@ -40,7 +40,7 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
            "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf|adams] [--rho-inf R]\n"
            "       [--order K (adams, 1 to 6)] [--rtol R] [--atol A]   (error control: --h is then "
            "the first step)\n"
-           "       [--coordinates absolute|joint]   (joint: spatial models)\n";
+           "       [--coordinates absolute|joint]\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
   for (int i = 1; i < argc; ++i) {

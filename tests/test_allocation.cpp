@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 #include "engine_model.hpp"
@@ -91,10 +92,14 @@ TEST_CASE("a BDF step allocates nothing, events and restarts included", "[worksp
 
 /// The engine from 5 ms to 50 ms, through ignition (an event and a restart), counting the
 /// allocations after a warm-up.
-template <class Integrator>
+template <class Integrator, class Engine = engine::Engine>
 void check_engine_run(const typename Integrator::Settings& settings, odyn::StepControl control) {
-  engine::Engine e = engine::build();
-  odyn::Workspace<engine::Model> ws(e.model);
+  Engine e;
+  if constexpr (std::is_same_v<Engine, engine::Engine>)
+    e = engine::build();
+  else
+    e = engine::planar::build();
+  odyn::Workspace<typename Engine::Model> ws(e.model);
   odyn::assemble(e.model, ws);
   Integrator integrator(e.model, ws, settings, control);
   odyn::advance_to(e.model, ws, integrator, 0.005, 1e-4);  // warm up
@@ -125,6 +130,15 @@ TEST_CASE("generalized-alpha and BDF steps allocate nothing in joint coordinates
           "[workspace][joint]") {
   check_engine_run<odyn::JointGeneralizedAlpha<engine::Model>>({}, {});
   check_engine_run<odyn::JointBdf<engine::Model>>({}, {.rtol = 1e-8, .atol = 1e-8});
+}
+
+TEST_CASE("planar joint coordinates' steps allocate nothing", "[workspace][joint][planar]") {
+  using Planar = engine::planar::Engine;
+  using Model = engine::planar::Model;
+  check_engine_run<odyn::JointDormandPrince853<Model>, Planar>(
+      {}, {.rtol = 1e-8, .atol = 1e-8, .first_step = 1e-5});
+  check_engine_run<odyn::JointGeneralizedAlpha<Model>, Planar>({}, {});
+  check_engine_run<odyn::JointBdf<Model>, Planar>({}, {.rtol = 1e-8, .atol = 1e-8});
 }
 
 TEST_CASE(

@@ -37,8 +37,7 @@ struct DynamicsSettings {
   std::string integrator = "generalized-alpha";
   /// What the integrator steps: "absolute" (every body's position and orientation, every joint
   /// a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that close
-  /// loops as constraints; spatial models; see analysis/joint_coordinates.hpp). BDF steps
-  /// absolute coordinates only.
+  /// loops as constraints; see analysis/joint_coordinates.hpp), with every integrator.
   std::string coordinates = "absolute";
   /// The factorization of the linear systems, in the assembly and the integrator: "auto"
   /// (dense for small models, sparse for large ones), "dense", "cholmod" or "klu"; see
@@ -428,27 +427,20 @@ template <class Model, class Observer>
 RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
                     Observer&& observe, AssembledStart<Model>* start = nullptr) {
   if (s.coordinates == "joint") {
-    if constexpr (std::is_same_v<typename Model::Space, Spatial>) {
-      if (s.integrator == "dopri5")
-        return simulate_with<JointDormandPrince>(model, ws, s, observe, start);
-      if (s.integrator == "dop853")
-        return simulate_with<JointDormandPrince853>(model, ws, s, observe, start);
-      if (s.integrator == "adams")
-        return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start);
-      if (s.integrator == "generalized-alpha" || s.integrator == "hht")
-        return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
-      if (s.integrator == "bdf") return simulate_with<JointBdf>(model, ws, s, observe, start);
-      throw ModelError("dynamics",
-                       "joint coordinates run with generalized-alpha, hht, bdf, dopri5, dop853 or "
-                       "adams, not '" +
-                           s.integrator +
-                           "'; choose one of those, or coordinates 'absolute' for this "
-                           "integrator");
-    } else {
-      throw ModelError("dynamics",
-                       "joint coordinates are implemented for spatial models; planar models run "
-                       "in absolute coordinates (coordinates 'absolute')");
-    }
+    if (s.integrator == "dopri5")
+      return simulate_with<JointDormandPrince>(model, ws, s, observe, start);
+    if (s.integrator == "dop853")
+      return simulate_with<JointDormandPrince853>(model, ws, s, observe, start);
+    if (s.integrator == "adams")
+      return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start);
+    if (s.integrator == "generalized-alpha" || s.integrator == "hht")
+      return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
+    if (s.integrator == "bdf") return simulate_with<JointBdf>(model, ws, s, observe, start);
+    throw ModelError("dynamics",
+                     "joint coordinates run with generalized-alpha, hht, bdf, dopri5, dop853 or "
+                     "adams, not '" +
+                         s.integrator +
+                         "'; choose one of those, or coordinates 'absolute' for this integrator");
   } else if (s.coordinates != "absolute") {
     throw ModelError("dynamics",
                      "unknown coordinates '" + s.coordinates + "'; choose 'absolute' or 'joint'");

@@ -39,7 +39,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--atol", type=float, help="absolute local error tolerance (likewise)")
     run.add_argument("--max-step", type=float, help="largest step with error control, s")
     run.add_argument("--coordinates", choices=["absolute", "joint"],
-                     help="spatial models, any integrator: step joint coordinates of a "
+                     help="any model and integrator: step joint coordinates of a "
                      "spanning tree (recursive, linear in the number of bodies), loops closed "
                      "by constraints (default: absolute)")
     run.add_argument("--linear-solver", choices=LINEAR_SOLVERS,

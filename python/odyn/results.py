@@ -313,9 +313,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     iteration of generalized-alpha and hht.
 
     coordinates: "absolute" (every body's position and orientation, every joint a constraint)
-    or, for spatial models with any integrator, "joint": the bodies located through a
-    spanning tree of revolute, translational, cylindrical, universal, fixed and spherical
-    joints, only the joints that close loops (distances, drivers, the rest) as constraints.
+    or, with any integrator, "joint": the bodies located through a spanning tree of revolute,
+    translational, cylindrical, universal, fixed and spherical joints (planar models: revolute,
+    translational and fixed), only the joints that close loops (distances, drivers, the rest) as constraints.
     Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
     dynamics); reactions and outputs are the same as in absolute coordinates. Generalized-alpha,
     hht and bdf there leave the spring and damper blocks that join two bodies out of Newton's

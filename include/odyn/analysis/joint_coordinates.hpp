@@ -3,18 +3,21 @@
 // only the joints that close loops stay constraint equations. The single-cylinder engine, for
 // instance, becomes crank angle, piston travel and the two angles of the piston pin, closed by
 // the crank pin's three equations: 4 coordinates and 3 equations instead of 18 and 17. A chain or
-// a tree of ball joints has no equation left at all.
+// a tree of ball joints has no equation left at all. Planar models work the same way in the
+// plane (the planar engine: crank, rod and piston angles, closed by the cylinder's two
+// equations), with motions and forces of 3 numbers instead of 6 (see tree_algebra.hpp).
 //
 // The tree. Joints that can carry a body (spatial::CarriesBody: revolute, translational,
-// cylindrical, universal, fixed and spherical) are taken greedily, most equations first
+// cylindrical, universal, fixed and spherical; planar::CarriesBody: revolute, translational
+// and fixed) are taken greedily, most equations first
 // (Kruskal), so that the joints left to close loops have the fewest equations; distances and
 // drivers always close loops. A group of bodies that no tree joint ties to the ground gets a
-// free root: one of its bodies keeps its own position and quaternion.
+// free root: one of its bodies keeps its own position and quaternion (angle, in the plane).
 //
 // The kinematics. A tree joint moves its child by a product of exponentials (see
-// spatial/screw.hpp), measured from the assembled start (every joint coordinate 0 there), or,
-// for a ball joint, by a quaternion whose rates are the relative angular velocity in the
-// child's axes (a free root's quaternion and rates work the same way). Every spatial quantity
+// spatial/screw.hpp, planar/screw.hpp), measured from the assembled start (every joint coordinate 0
+// there), or, for a ball joint, by a quaternion whose rates are the relative angular velocity in
+// the child's axes (a free root's quaternion and rates work the same way). Every spatial quantity
 // of a body (its twist (omega, v), its acceleration, its inertia, the wrenches on it) is given
 // in global axes at the body's own centre of mass, so a parent and its child differ by the
 // shift r = c_child - c_parent alone, and no lever arm grows with the distance from the global
@@ -51,7 +54,7 @@
 // (see factorize(const IterationFactors&)). BDF keeps three such factorizations apart (slots:
 // its Newton matrix, its projection's and its outputs').
 //
-// Limits: spatial models; loop closures must be independent (a redundant closure, as in
+// Limits: loop closures must be independent (a redundant closure, as in
 // Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
 
 #include <Eigen/Cholesky>
@@ -68,63 +71,85 @@
 
 #include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/analysis/tree_algebra.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/implicit_configuration.hpp"
 #include "odyn/core/rotation.hpp"
-#include "odyn/core/spatial.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/linear_solver.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/saddle_point_ldlt.hpp"
-#include "odyn/spatial/screw.hpp"
 
 namespace odyn {
 
 namespace detail {
 
-/// What the passes over the tree keep per body, in global axes at its centre.
+/// What the passes over the tree keep per body, in global axes at its centre (see
+/// tree_algebra.hpp: a motion or a force has D = 6 numbers in space, 3 in the plane; a joint
+/// has at most D degrees of freedom).
+template <class Space>
 struct TreeNodeState {
-  Eigen::Matrix<double, 6, 6> motion =
-      Eigen::Matrix<double, 6, 6>::Zero();  // S: the joint's twists per unit rate (dof cols)
-  Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();  // V = (omega, v_centre)
-  Eigen::Matrix<double, 6, 1> bias =
-      Eigen::Matrix<double, 6, 1>::Zero();  // c: the joint's acceleration at zero theta''
-  Eigen::Matrix<double, 6, 1> pivot_force =
-      Eigen::Matrix<double, 6, 1>::Zero();           // u = -S^T p in a solve (dof entries)
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // r = c_child - c_parent
+  using Algebra = TreeAlgebra<Space>;
+  using Motion = typename Algebra::Motion;
+  using MotionMatrix = typename Algebra::MotionMatrix;
+  MotionMatrix motion = MotionMatrix::Zero();  // S: the joint's twists per unit rate (dof cols)
+  Motion twist = Motion::Zero();               // V = (omega, v_centre)
+  Motion bias = Motion::Zero();                // c: the joint's acceleration at zero theta''
+  Motion pivot_force = Motion::Zero();         // u = -S^T p in a solve (dof entries)
+  typename Algebra::Linear offset = Algebra::Linear::Zero();  // r = c_child - c_parent
 };
 
 /// One tree node's part of a factorization of A (the articulated-body algorithm's).
+template <class Space>
 struct NodeFactor {
-  Eigen::Matrix<double, 6, 6> articulated =
-      Eigen::Matrix<double, 6, 6>::Zero();  // I^A during factorize(), then I^A - U D^-1 U^T
-  Eigen::Matrix<double, 6, 6> projected =
-      Eigen::Matrix<double, 6, 6>::Zero();  // U = I^A S (dof cols)
-  Eigen::Matrix<double, 6, 6> inverse_pivot =
-      Eigen::Matrix<double, 6, 6>::Zero();  // D^-1 = (S^T I^A S)^-1 (dof x dof)
+  using MotionMatrix = typename TreeAlgebra<Space>::MotionMatrix;
+  MotionMatrix articulated = MotionMatrix::Zero();    // I^A in factorize(), then I^A - U D^-1 U^T
+  MotionMatrix projected = MotionMatrix::Zero();      // U = I^A S (dof cols)
+  MotionMatrix inverse_pivot = MotionMatrix::Zero();  // D^-1 = (S^T I^A S)^-1 (dof x dof)
 };
 
 /// One closure's Jacobian block on one body in spatial form, G = [Phi_angular R^T,
 /// Phi_linear], so that Phi_q v = G V with V the body's twist at its centre.
+template <class Space>
 struct ClosureBlock {
-  int node = 0;   // the body's place in tree_
-  int row = 0;    // first row in the closures' equations
-  int count = 0;  // rows
-  Eigen::Matrix<double, 6, 6> rows = Eigen::Matrix<double, 6, 6>::Zero();  // count rows used
+  static constexpr int max_rows = 6;  // an element's equations
+  int node = 0;                       // the body's place in tree_
+  int row = 0;                        // first row in the closures' equations
+  int count = 0;                      // rows
+  Eigen::Matrix<double, max_rows, TreeAlgebra<Space>::size> rows =
+      Eigen::Matrix<double, max_rows, TreeAlgebra<Space>::size>::Zero();  // count rows used
 };
 
 }  // namespace detail
 
 template <class Model>
 class JointCoordinates {
-  static_assert(std::is_same_v<typename Model::Space, Spatial>,
-                "joint coordinates are implemented for spatial models");
-  using Vector6 = Eigen::Matrix<double, 6, 1>;
-  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Space = typename Model::Space;
+  using Algebra = detail::TreeAlgebra<Space>;
+  static constexpr bool spatial_model = std::is_same_v<Space, Spatial>;
+  static constexpr int A = Algebra::angular;  // omega's components in a motion, at its head
+  static constexpr int L = Algebra::linear;   // v's components, at its tail
+  static constexpr int D = Algebra::size;
+  using Motion = typename Algebra::Motion;
+  using MotionMatrix = typename Algebra::MotionMatrix;
+  using Linear = typename Algebra::Linear;
   using Quaternion = Eigen::Matrix<double, 4, 1>;  // (w, x, y, z)
-  using Frame = Spatial::Frame;
-  using Screw = spatial::Screw;
+  using Frame = typename Space::Frame;
+  using Screw = typename Algebra::Screw;
+  using ClosureBlock = detail::ClosureBlock<Space>;
+  using NodeState = detail::TreeNodeState<Space>;
+  using NodeFactor = detail::NodeFactor<Space>;
+
+  /// A motion's angular part omega (a force's torque) and its linear part v (a force's force).
+  template <class Vector>
+  static auto angular(Vector& motion) {
+    return motion.template head<A>();
+  }
+  template <class Vector>
+  static auto linear(Vector& motion) {
+    return motion.template tail<L>();
+  }
 
  public:
   static constexpr const char* name = "joint";
@@ -170,7 +195,7 @@ class JointCoordinates {
     ws_.t = t;
     q_ = y.head(num_positions());
     for (const TreeBody& node : tree_) {
-      if (node.kind == Kind::free) Spatial::normalize(q_.segment<Spatial::nq>(node.q_offset));
+      if (node.kind == Kind::free) Space::normalize(q_.segment<Space::nq>(node.q_offset));
       if (node.kind == Kind::ball) q_.segment<4>(node.q_offset).normalize();
     }
     v_ = y.tail(num_velocities());
@@ -197,10 +222,10 @@ class JointCoordinates {
         const int b = element.bodies()[k].index;
         if (b == 0) continue;
         // Phi_q v = Phi_linear v_centre + Phi_angular R^T omega = G (omega, v_centre).
-        detail::ClosureBlock& block = closure_blocks_[next++];
-        block.rows.template topLeftCorner<m, 3>().noalias() =
-            blocks.jacobian[k].template rightCols<3>() * ws_.frames[b].rotation.transpose();
-        block.rows.template topRightCorner<m, 3>() = blocks.jacobian[k].template leftCols<3>();
+        ClosureBlock& block = closure_blocks_[next++];
+        block.rows.template topLeftCorner<m, A>().noalias() =
+            blocks.jacobian[k].template rightCols<A>() * Algebra::axes(ws_.frames[b]).transpose();
+        block.rows.template topRightCorner<m, L>() = blocks.jacobian[k].template leftCols<L>();
       }
     });
   }
@@ -221,11 +246,12 @@ class JointCoordinates {
   void load_inertias() {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const auto& body = model_.body(BodyId{tree_[i].body});
-      const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
-      Matrix6& inertia = factor(i).articulated;
+      const auto& rotation = Algebra::axes(ws_.frames[tree_[i].body]);
+      MotionMatrix& inertia = factor(i).articulated;
       inertia.setZero();
-      inertia.topLeftCorner<3, 3>().noalias() = rotation * body.inertia * rotation.transpose();
-      inertia.bottomRightCorner<3, 3>().diagonal().setConstant(body.mass);
+      inertia.template topLeftCorner<A, A>().noalias() =
+          rotation * Algebra::inertia(body.inertia) * rotation.transpose();
+      inertia.template bottomRightCorner<L, L>().diagonal().setConstant(body.mass);
     }
   }
 
@@ -263,12 +289,10 @@ class JointCoordinates {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const int b = tree_[i].body;
       const Frame& frame = ws_.frames[b];
-      const Vector6& twist = nodes_[i].twist;
+      const Motion& twist = nodes_[i].twist;
       const double mass = model_.body(BodyId{b}).mass;
-      force_[i].head<3>().noalias() =
-          -(frame.rotation * ws_.force.template segment<3>(6 * (b - 1) + 3));
-      force_[i].tail<3>() = mass * twist.head<3>().cross(twist.tail<3>()) -
-                            ws_.force.template segment<3>(6 * (b - 1));
+      angular(force_[i]).noalias() = -(Algebra::axes(frame) * torque_on(b));
+      linear(force_[i]) = mass * Algebra::turn(angular(twist), linear(twist)) - force_on(b);
     }
     // The closures' right-hand side in spatial form: gamma less Phi_linear (omega x v_centre),
     // the part of the centre's acceleration that the spatial acceleration leaves out.
@@ -278,9 +302,9 @@ class JointCoordinates {
       for (int k = 0; k < E::num_bodies; ++k) {
         const int b = element.bodies()[k].index;
         if (b == 0) continue;
-        const Vector6& twist = nodes_[node_of_[b]].twist;
-        g.noalias() -=
-            blocks.jacobian[k].template leftCols<3>() * twist.head<3>().cross(twist.tail<3>());
+        const Motion& twist = nodes_[node_of_[b]].twist;
+        g.noalias() -= blocks.jacobian[k].template leftCols<L>() *
+                       Algebra::turn(angular(twist), linear(twist));
       }
     });
     saddle_solve(true, true, closure_rhs_, qdd_, lambda_);
@@ -317,9 +341,9 @@ class JointCoordinates {
     saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        const Eigen::Matrix<double, Spatial::nq, 1> from = q_.segment<Spatial::nq>(node.q_offset);
-        Spatial::integrate(from, increment_.segment<Spatial::nv>(node.v_offset),
-                           q_.segment<Spatial::nq>(node.q_offset));
+        const Eigen::Matrix<double, Space::nq, 1> from = q_.segment<Space::nq>(node.q_offset);
+        Space::integrate(from, increment_.segment<Space::nv>(node.v_offset),
+                         q_.segment<Space::nq>(node.q_offset));
       } else if (node.kind == Kind::ball) {
         turn(q_.segment<4>(node.q_offset), increment_.segment<3>(node.v_offset));
       } else {
@@ -339,8 +363,8 @@ class JointCoordinates {
     if (num_equations() == 0) return;
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free)
-        increment_.segment<Spatial::nv>(node.v_offset) = Spatial::increment_of(
-            q_.segment<Spatial::nq>(node.q_offset), error.segment<Spatial::nq>(node.q_offset));
+        increment_.segment<Space::nv>(node.v_offset) = Space::increment_of(
+            q_.segment<Space::nq>(node.q_offset), error.segment<Space::nq>(node.q_offset));
       else if (node.kind == Kind::ball)
         increment_.segment<3>(node.v_offset) =
             turn_of(q_.segment<4>(node.q_offset), error.segment<4>(node.q_offset));
@@ -355,7 +379,7 @@ class JointCoordinates {
   /// max |C theta' + Phi_t| at the loaded state (constraints evaluated).
   double velocity_residual() {
     if (num_equations() == 0) return 0.0;
-    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);
+    closure_rates_of([&](int i) -> const Motion& { return nodes_[i].twist; }, closure_rhs_);
     return (closure_rhs_ + phi_t_).cwiseAbs().maxCoeff();
   }
 
@@ -365,7 +389,7 @@ class JointCoordinates {
     correct_velocities();
   }
   void correct_velocities() {
-    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, closure_rhs_);
+    closure_rates_of([&](int i) -> const Motion& { return nodes_[i].twist; }, closure_rhs_);
     closure_rhs_ = -(closure_rhs_ + phi_t_);
     saddle_solve(false, false, closure_rhs_, increment_, multiplier_);
     v_ += increment_;
@@ -384,9 +408,9 @@ class JointCoordinates {
                  Eigen::VectorXd& to) const {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        Spatial::integrate(from.segment<Spatial::nq>(node.q_offset),
-                           increment.segment<Spatial::nv>(node.v_offset),
-                           to.segment<Spatial::nq>(node.q_offset));
+        Space::integrate(from.segment<Space::nq>(node.q_offset),
+                         increment.segment<Space::nv>(node.v_offset),
+                         to.segment<Space::nq>(node.q_offset));
       } else if (node.kind == Kind::ball) {
         to.segment<4>(node.q_offset) = from.segment<4>(node.q_offset);
         turn(to.segment<4>(node.q_offset), increment.segment<3>(node.v_offset));
@@ -404,7 +428,7 @@ class JointCoordinates {
   void dynamics_residual(Eigen::Ref<Eigen::VectorXd> out) {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const TreeBody& node = tree_[i];
-      Vector6 acceleration = nodes_[i].bias;
+      Motion acceleration = nodes_[i].bias;
       if (node.parent_node >= 0)
         acceleration += shifted_motion(motion_[node.parent_node], nodes_[i].offset);
       acceleration.noalias() +=
@@ -414,14 +438,15 @@ class JointCoordinates {
       // it (the gyroscopic torque is part of Q), at its centre in global axes.
       const int b = node.body;
       const auto& body = model_.body(BodyId{b});
-      const Eigen::Matrix3d& rotation = ws_.frames[b].rotation;
-      const Vector6& twist = nodes_[i].twist;
-      force_[i].head<3>().noalias() =
-          rotation * (body.inertia * (rotation.transpose() * acceleration.head<3>()) -
-                      ws_.force.template segment<3>(6 * (b - 1) + 3));
-      force_[i].tail<3>() =
-          body.mass * (acceleration.tail<3>() + twist.head<3>().cross(twist.tail<3>())) -
-          ws_.force.template segment<3>(6 * (b - 1));
+      const auto& rotation = Algebra::axes(ws_.frames[b]);
+      const Motion& twist = nodes_[i].twist;
+      angular(force_[i]).noalias() =
+          rotation *
+          (Algebra::inertia(body.inertia) * (rotation.transpose() * angular(acceleration)) -
+           torque_on(b));
+      linear(force_[i]) =
+          body.mass * (linear(acceleration) + Algebra::turn(angular(twist), linear(twist))) -
+          force_on(b);
     }
     add_closure_wrenches(lambda_, 1.0, force_);
     for (std::size_t i = tree_.size(); i-- > 0;) {
@@ -438,7 +463,7 @@ class JointCoordinates {
 
   /// C theta' + Phi_t at the loaded state (constraints evaluated).
   const Eigen::VectorXd& velocity_constraint_values() {
-    closure_rates_of([&](int i) -> const Vector6& { return nodes_[i].twist; }, velocity_values_);
+    closure_rates_of([&](int i) -> const Motion& { return nodes_[i].twist; }, velocity_values_);
     velocity_values_ += phi_t_;
     return velocity_values_;
   }
@@ -450,10 +475,10 @@ class JointCoordinates {
                           const Eigen::VectorXd& w) {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        implicit_configuration<Spatial>(
-            beta.segment<Spatial::nq>(node.q_offset), c,
-            Eigen::Matrix<double, Spatial::nv, 1>(w.segment<Spatial::nv>(node.v_offset)),
-            q_.segment<Spatial::nq>(node.q_offset));
+        implicit_configuration<Space>(
+            beta.segment<Space::nq>(node.q_offset), c,
+            Eigen::Matrix<double, Space::nv, 1>(w.segment<Space::nv>(node.v_offset)),
+            q_.segment<Space::nq>(node.q_offset));
       } else if (node.kind == Kind::ball) {
         // q' = q (0, w) / 2 = R(w) q: (1 - c R(w)) q = beta.
         const Eigen::Vector3d rate = w.segment<3>(node.v_offset);
@@ -526,8 +551,8 @@ class JointCoordinates {
   void error_scale(Eigen::VectorXd& out) const {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        out.segment<Spatial::nv>(node.v_offset) =
-            Spatial::coordinate_scale(q_.segment<Spatial::nq>(node.q_offset));
+        out.segment<Space::nv>(node.v_offset) =
+            Space::coordinate_scale(q_.segment<Space::nq>(node.q_offset));
       } else if (node.kind == Kind::ball) {
         out.segment<3>(node.v_offset).setOnes();
       } else {
@@ -553,28 +578,32 @@ class JointCoordinates {
   void complete_workspace() {
     for (int b = 1; b <= model_.num_bodies(); ++b) {
       const Frame& frame = ws_.frames[b];
-      const Eigen::Quaterniond rotation(frame.rotation);
-      ws_.q.template segment<3>(7 * (b - 1)) = frame.position;
-      ws_.q.template segment<4>(7 * (b - 1) + 3) << rotation.w(), rotation.x(), rotation.y(),
-          rotation.z();
-      ws_.v.template segment<3>(6 * (b - 1)) = frame.linear_velocity;
-      ws_.v.template segment<3>(6 * (b - 1) + 3) = frame.angular_velocity;
+      auto q = ws_.q.template segment<Space::nq>(Space::nq * (b - 1));
+      q.template head<Space::dim>() = frame.position;
+      if constexpr (spatial_model) {
+        const Eigen::Quaterniond rotation(frame.rotation);
+        q.template tail<4>() << rotation.w(), rotation.x(), rotation.y(), rotation.z();
+      } else {
+        q[2] = frame.angle;
+      }
+      ws_.v.template segment<L>(Space::nv * (b - 1)) = frame.linear_velocity;
+      ws_.v.template segment<A>(Space::nv * (b - 1) + L) = frame.angular_velocity;
     }
     // v' from theta'': the spatial accelerations down the tree, then the centres' accelerations
     // (the spatial one plus omega x v_centre) and the body-frame angular accelerations.
     for (std::size_t i = 0; i < tree_.size(); ++i) {
-      Vector6 acceleration = nodes_[i].bias;
+      Motion acceleration = nodes_[i].bias;
       if (tree_[i].parent_node >= 0)
         acceleration += shifted_motion(motion_[tree_[i].parent_node], nodes_[i].offset);
       acceleration.noalias() += nodes_[i].motion.leftCols(tree_[i].dof()) *
                                 qdd_.segment(tree_[i].v_offset, tree_[i].dof());
       motion_[i] = acceleration;
       const int b = tree_[i].body;
-      const Vector6& twist = nodes_[i].twist;
-      ws_.vdot.template segment<3>(6 * (b - 1)) =
-          acceleration.tail<3>() + twist.head<3>().cross(twist.tail<3>());
-      ws_.vdot.template segment<3>(6 * (b - 1) + 3).noalias() =
-          ws_.frames[b].rotation.transpose() * acceleration.head<3>();
+      const Motion& twist = nodes_[i].twist;
+      ws_.vdot.template segment<L>(Space::nv * (b - 1)) =
+          linear(acceleration) + Algebra::turn(angular(twist), linear(twist));
+      ws_.vdot.template segment<A>(Space::nv * (b - 1) + L).noalias() =
+          Algebra::axes(ws_.frames[b]).transpose() * angular(acceleration);
     }
     // Each body's constraint forces Phi_q^T lambda, from the closures first.
     constraint_force_.setZero();
@@ -584,7 +613,7 @@ class JointCoordinates {
       for (int k = 0; k < E::num_bodies; ++k) {
         const int b = element.bodies()[k].index;
         if (b != 0)
-          constraint_force_.segment<6>(6 * (b - 1)).noalias() +=
+          constraint_force_.segment<Space::nv>(Space::nv * (b - 1)).noalias() +=
               blocks.jacobian[k].transpose() * lambda;
       }
     });
@@ -597,12 +626,13 @@ class JointCoordinates {
       if (node->kind == Kind::free) continue;
       const int b = node->body;
       const auto& body = model_.body(BodyId{b});
-      const Vector6 left =
-          ws_.force.template segment<6>(6 * (b - 1)) -
-          Spatial::mass_times(body.mass, body.inertia, ws_.vdot.template segment<6>(6 * (b - 1))) -
-          constraint_force_.segment<6>(6 * (b - 1));
+      const int at = Space::nv * (b - 1);
+      const typename Space::Velocity left =
+          ws_.force.template segment<Space::nv>(at) -
+          Space::mass_times(body.mass, body.inertia, ws_.vdot.template segment<Space::nv>(at)) -
+          constraint_force_.segment<Space::nv>(at);
       model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-        if constexpr (spatial::CarriesBody<E>) {
+        if constexpr (Algebra::template carries_body<E>) {
           if (type != node->joint_type) return;
           constexpr int m = E::num_equations;
           const E& joint = pool[node->joint_index];
@@ -624,7 +654,7 @@ class JointCoordinates {
             lambda = normal.completeOrthogonalDecomposition().solve(on_child * left);
           ws_.lambda.template segment<m>(row) = lambda;
           if (node->parent != 0)
-            constraint_force_.segment<6>(6 * (node->parent - 1)).noalias() +=
+            constraint_force_.segment<Space::nv>(Space::nv * (node->parent - 1)).noalias() +=
                 blocks.jacobian[1 - node->child_side].transpose() * lambda;
         }
       });
@@ -640,16 +670,22 @@ class JointCoordinates {
     int parent_node = -1;  // the parent's place in tree_ (-1: the ground)
     Kind kind = Kind::screws;
     int q_offset = 0, v_offset = 0;
-    std::size_t joint_type = 0, joint_index = 0;      // the tree joint: type in the model, index
-    int child_side = 1;                               // which of its bodies this one is
-    std::vector<Screw> screws;                        // a screw joint's motions
-    Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // a ball joint's point, parent's coords
-    Eigen::Matrix3d rotation0 = Eigen::Matrix3d::Identity();  // in the parent's frame at start
-    Eigen::Vector3d position0 = Eigen::Vector3d::Zero();
+    std::size_t joint_type = 0, joint_index = 0;  // the tree joint: type in the model, index
+    int child_side = 1;                           // which of its bodies this one is
+    std::vector<Screw> screws;                    // a screw joint's motions
+    Linear pivot = Linear::Zero();                // a ball joint's point, parent's coords
+    // The child's pose in the parent's frame at the start (a planar one's angle apart).
+    typename Space::RotationMatrix rotation0 = Space::RotationMatrix::Identity();
+    double angle0 = 0.0;
+    Linear position0 = Linear::Zero();
     int dof() const {
-      return kind == Kind::free ? 6 : kind == Kind::ball ? 3 : static_cast<int>(screws.size());
+      return kind == Kind::free   ? Space::nv
+             : kind == Kind::ball ? 3
+                                  : static_cast<int>(screws.size());
     }
-    int num_positions() const { return kind == Kind::free ? 7 : kind == Kind::ball ? 4 : dof(); }
+    int num_positions() const {
+      return kind == Kind::free ? Space::nq : kind == Kind::ball ? 4 : dof();
+    }
   };
 
   /// f.template operator()<K>() with the number of degrees of freedom K as a constant.
@@ -662,38 +698,40 @@ class JointCoordinates {
         return f.template operator()<1>();
       case 2:
         return f.template operator()<2>();
-      case 3:
-        return f.template operator()<3>();
-      case 4:
-        return f.template operator()<4>();
-      case 5:
-        return f.template operator()<5>();
       default:
-        return f.template operator()<6>();
+        if constexpr (D == 3) {
+          return f.template operator()<3>();
+        } else {
+          switch (dof) {
+            case 3:
+              return f.template operator()<3>();
+            case 4:
+              return f.template operator()<4>();
+            case 5:
+              return f.template operator()<5>();
+            default:
+              return f.template operator()<6>();
+          }
+        }
     }
   }
 
+  /// The applied force and torque (body axes) on body b, from the last evaluate_forces.
+  auto force_on(int b) const { return ws_.force.template segment<L>(Space::nv * (b - 1)); }
+  auto torque_on(int b) const { return ws_.force.template segment<A>(Space::nv * (b - 1) + L); }
+
   /// A motion vector (twist or acceleration) at the parent's centre, seen at the child's.
-  static Vector6 shifted_motion(const Vector6& motion, const Eigen::Vector3d& offset) {
-    Vector6 out;
-    out.head<3>() = motion.head<3>();
-    out.tail<3>() = motion.tail<3>() + motion.head<3>().cross(offset);
+  static Motion shifted_motion(const Motion& motion, const Linear& offset) {
+    Motion out;
+    angular(out) = angular(motion);
+    linear(out) = linear(motion) + Algebra::turn(angular(motion), offset);
     return out;
   }
 
   /// into += a wrench at a child's centre moved to its parent's: torque plus r x force.
-  static void add_shifted_force(const Vector6& force, const Eigen::Vector3d& offset,
-                                Vector6& into) {
-    into.head<3>() += force.head<3>() + offset.cross(force.tail<3>());
-    into.tail<3>() += force.tail<3>();
-  }
-
-  /// (omega, v) x (omega', v') = (omega x omega', omega x v' + v x omega').
-  static Vector6 motion_cross(const Vector6& a, const Vector6& b) {
-    Vector6 out;
-    out.head<3>() = a.head<3>().cross(b.head<3>());
-    out.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
-    return out;
+  static void add_shifted_force(const Motion& force, const Linear& offset, Motion& into) {
+    angular(into) += angular(force) + Algebra::moment(offset, linear(force));
+    linear(into) += linear(force);
   }
 
   /// Adds to each body's inertia (factorize_loaded's start) the symmetric part of its own blocks
@@ -701,10 +739,11 @@ class JointCoordinates {
   /// terms, turned from the bodies' velocity coordinates (v_centre, omega in body axes) to the
   /// spatial form at the centre (omega, v_centre in global axes): T^T B T, T = [0 1; R^T 0].
   void add_own_force_blocks(double stiffness_factor, double damping_factor) {
-    using Block = typename Spatial::MassBlock;
+    using Block = typename Space::MassBlock;
+    constexpr int nv = Space::nv;
     for (int b = 1; b <= model_.num_bodies(); ++b)
-      own_blocks_[b] = damping_factor *
-                       Spatial::gyroscopic_damping(model_.body(BodyId{b}).inertia, ws_.frames[b]);
+      own_blocks_[b] =
+          damping_factor * Space::gyroscopic_damping(model_.body(BodyId{b}).inertia, ws_.frames[b]);
     model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
       if constexpr (HasForceJacobians<E>) {
         ForceBlocksOf<E> blocks;
@@ -714,8 +753,8 @@ class JointCoordinates {
             const int b = element.bodies()[k].index;
             if (b == 0) continue;
             own_blocks_[b] +=
-                stiffness_factor * blocks.stiffness.template block<6, 6>(6 * k, 6 * k) +
-                damping_factor * blocks.damping.template block<6, 6>(6 * k, 6 * k);
+                stiffness_factor * blocks.stiffness.template block<nv, nv>(nv * k, nv * k) +
+                damping_factor * blocks.damping.template block<nv, nv>(nv * k, nv * k);
           }
         }
       }
@@ -723,27 +762,28 @@ class JointCoordinates {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const int b = tree_[i].body;
       const Block symmetric = 0.5 * (own_blocks_[b] + own_blocks_[b].transpose());
-      const Eigen::Matrix3d& rotation = ws_.frames[b].rotation;
+      const auto& rotation = Algebra::axes(ws_.frames[b]);
       // B = [B_vv B_vw; B_wv B_ww] in (v, omega_body); spatial (omega, v): T^T B T.
-      Matrix6& inertia = factor(i).articulated;
-      inertia.topLeftCorner<3, 3>().noalias() +=
-          rotation * symmetric.bottomRightCorner<3, 3>() * rotation.transpose();
-      const Eigen::Matrix3d coupling = rotation * symmetric.bottomLeftCorner<3, 3>();
-      inertia.topRightCorner<3, 3>() += coupling;
-      inertia.bottomLeftCorner<3, 3>() += coupling.transpose();
-      inertia.bottomRightCorner<3, 3>() += symmetric.topLeftCorner<3, 3>();
+      MotionMatrix& inertia = factor(i).articulated;
+      inertia.template topLeftCorner<A, A>().noalias() +=
+          rotation * symmetric.template bottomRightCorner<A, A>() * rotation.transpose();
+      const Eigen::Matrix<double, A, L> coupling =
+          rotation * symmetric.template bottomLeftCorner<A, L>();
+      inertia.template topRightCorner<A, L>() += coupling;
+      inertia.template bottomLeftCorner<L, A>() += coupling.transpose();
+      inertia.template bottomRightCorner<L, L>() += symmetric.template topLeftCorner<L, L>();
     }
   }
 
   /// Node i's part of the factorization in the current slot.
-  detail::NodeFactor& factor(std::size_t i) { return factors_[slot_][i]; }
+  NodeFactor& factor(std::size_t i) { return factors_[slot_][i]; }
 
   /// ABA's inertia step for node i: U, D^-1, I^A - U D^-1 U^T, which the parent inherits
   /// shifted to its centre: X^T I X, X = [1 0; -[r] 1], r = c_child - c_parent.
   template <int K>
   bool factor_node(std::size_t i) {
-    const detail::TreeNodeState& node = nodes_[i];
-    detail::NodeFactor& own = factor(i);
+    const NodeState& node = nodes_[i];
+    NodeFactor& own = factor(i);
     if constexpr (K > 0) {
       const auto motion = node.motion.template leftCols<K>();
       auto projected = own.projected.template leftCols<K>();
@@ -756,22 +796,9 @@ class JointCoordinates {
       own.articulated.noalias() -= projected * (inverse * projected.transpose());
     }
     const int parent = tree_[i].parent_node;
-    if (parent >= 0) add_shifted_inertia(own.articulated, node.offset, factor(parent).articulated);
+    if (parent >= 0)
+      Algebra::add_shifted_inertia(own.articulated, node.offset, factor(parent).articulated);
     return true;
-  }
-
-  /// into += X^T inertia X, the inertia at a child's centre seen at its parent's:
-  /// X = [1 0; -[r] 1], r = c_child - c_parent.
-  static void add_shifted_inertia(const Matrix6& inertia, const Eigen::Vector3d& offset,
-                                  Matrix6& into) {
-    const Eigen::Matrix3d arm = skew(offset);
-    const Eigen::Matrix3d coupling =
-        inertia.topRightCorner<3, 3>() + arm * inertia.bottomRightCorner<3, 3>();
-    into.topLeftCorner<3, 3>() += inertia.topLeftCorner<3, 3>() +
-                                  arm * inertia.topRightCorner<3, 3>().transpose() - coupling * arm;
-    into.topRightCorner<3, 3>() += coupling;
-    into.bottomLeftCorner<3, 3>() += coupling.transpose();
-    into.bottomRightCorner<3, 3>() += inertia.bottomRightCorner<3, 3>();
   }
 
   /// The saddle-point matrix [A C^T; C 0] of a small model, lower triangle, factorized L D L^T.
@@ -783,12 +810,12 @@ class JointCoordinates {
     const Eigen::Index n = num_velocities();
     for (std::size_t i = tree_.size(); i-- > 0;)
       if (tree_[i].parent_node >= 0)
-        add_shifted_inertia(factor(i).articulated, nodes_[i].offset,
-                            factor(tree_[i].parent_node).articulated);
+        Algebra::add_shifted_inertia(factor(i).articulated, nodes_[i].offset,
+                                     factor(tree_[i].parent_node).articulated);
     kkt_.setZero();
-    // Entries one 6-vector product at a time: at these sizes, Eigen's products of blocks of
+    // Entries one motion-vector product at a time: at these sizes, Eigen's products of blocks of
     // run-time size cost more in their set-up than in their arithmetic.
-    const auto fill = [&](const Vector6* left, int rows, int row0, const Matrix6& right,
+    const auto fill = [&](const Motion* left, int rows, int row0, const MotionMatrix& right,
                           int columns, int column0) {
       for (int r = 0; r < rows; ++r)
         for (int c = 0; c < columns; ++c) kkt_(row0 + r, column0 + c) += left[r].dot(right.col(c));
@@ -796,20 +823,20 @@ class JointCoordinates {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const int dof = tree_[i].dof();
       if (dof == 0) continue;
-      std::array<Vector6, 6> momentum;  // I^c S, carried up the tree
+      std::array<Motion, D> momentum;  // I^c S, carried up the tree
       for (int k = 0; k < dof; ++k)
         momentum[k].noalias() = factor(i).articulated * nodes_[i].motion.col(k);
       fill(momentum.data(), dof, tree_[i].v_offset, nodes_[i].motion, dof, tree_[i].v_offset);
       for (int j = static_cast<int>(i); tree_[j].parent_node >= 0;) {
         for (int k = 0; k < dof; ++k)
-          momentum[k].head<3>() += nodes_[j].offset.cross(momentum[k].tail<3>());
+          angular(momentum[k]) += Algebra::moment(nodes_[j].offset, linear(momentum[k]));
         j = tree_[j].parent_node;
         fill(momentum.data(), dof, tree_[i].v_offset, nodes_[j].motion, tree_[j].dof(),
              tree_[j].v_offset);
       }
     }
-    for (const detail::ClosureBlock& block : closure_blocks_) {
-      std::array<Vector6, 6> rows;
+    for (const ClosureBlock& block : closure_blocks_) {
+      std::array<Motion, ClosureBlock::max_rows> rows;
       for (int r = 0; r < block.count; ++r) rows[r] = block.rows.row(r).transpose();
       for (int j = block.node; j >= 0; j = tree_[j].parent_node) {
         // G moved to node j's centre, so that it reads j's motion columns there: the rows act
@@ -817,7 +844,7 @@ class JointCoordinates {
         fill(rows.data(), block.count, static_cast<int>(n) + block.row, nodes_[j].motion,
              tree_[j].dof(), tree_[j].v_offset);
         for (int r = 0; r < block.count; ++r)
-          rows[r].head<3>() += nodes_[j].offset.cross(rows[r].tail<3>());
+          angular(rows[r]) += Algebra::moment(nodes_[j].offset, linear(rows[r]));
       }
     }
     return kkt_ldlts_[slot_].compute(kkt_);
@@ -827,9 +854,9 @@ class JointCoordinates {
   /// p + I^a c + U D^-1 u, moved to the parent's centre (torque plus r x force).
   template <int K>
   bool backward_node(std::size_t i, bool with_bias, const Eigen::VectorXd* joint_force) {
-    detail::TreeNodeState& node = nodes_[i];
-    const detail::NodeFactor& own = factor(i);
-    Vector6 handed = force_[i];
+    NodeState& node = nodes_[i];
+    const NodeFactor& own = factor(i);
+    Motion handed = force_[i];
     if (with_bias) handed.noalias() += own.articulated * node.bias;
     if constexpr (K > 0) {
       auto u = node.pivot_force.template head<K>();
@@ -847,14 +874,14 @@ class JointCoordinates {
   /// a' the parent's acceleration at this centre (plus c).
   template <int K>
   bool forward_node(std::size_t i, bool with_bias, Eigen::Ref<Eigen::VectorXd> x,
-                    std::vector<Vector6>& acceleration) {
-    const detail::TreeNodeState& node = nodes_[i];
+                    std::vector<Motion>& acceleration) {
+    const NodeState& node = nodes_[i];
     const int parent = tree_[i].parent_node;
-    Vector6 a = parent >= 0 ? shifted_motion(acceleration[parent], node.offset) : Vector6::Zero();
+    Motion a = parent >= 0 ? shifted_motion(acceleration[parent], node.offset) : Motion::Zero();
     if (with_bias) a += node.bias;
     if constexpr (K > 0) {
       auto theta = x.segment<K>(tree_[i].v_offset);
-      const detail::NodeFactor& own = factor(i);
+      const NodeFactor& own = factor(i);
       theta.noalias() = own.inverse_pivot.template topLeftCorner<K, K>() *
                         (node.pivot_force.template head<K>() -
                          own.projected.template leftCols<K>().transpose() * a);
@@ -867,7 +894,7 @@ class JointCoordinates {
   /// x = A^-1 (J^T w + tau) with the factorization of the last factorize(), and every body's
   /// motion J x (+ c with_bias) into `acceleration`. force_ holds p = -w per body (plus the
   /// velocity terms with_bias) and is used up; tau (joint forces, per rate) may be absent.
-  void tree_solve(bool with_bias, Eigen::Ref<Eigen::VectorXd> x, std::vector<Vector6>& acceleration,
+  void tree_solve(bool with_bias, Eigen::Ref<Eigen::VectorXd> x, std::vector<Motion>& acceleration,
                   const Eigen::VectorXd* joint_force = nullptr) {
     for (std::size_t i = tree_.size(); i-- > 0;)
       with_dof(tree_[i].dof(),
@@ -917,10 +944,10 @@ class JointCoordinates {
         if (parent >= 0) motion_[i] += shifted_motion(motion_[parent], nodes_[i].offset);
         // p + M c, M the body's own inertia at its centre (global axes).
         const auto& body = model_.body(BodyId{tree_[i].body});
-        const Eigen::Matrix3d& rotation = ws_.frames[tree_[i].body].rotation;
-        force_[i].head<3>().noalias() +=
-            rotation * (body.inertia * (rotation.transpose() * motion_[i].head<3>()));
-        force_[i].tail<3>() += body.mass * motion_[i].tail<3>();
+        const auto& rotation = Algebra::axes(ws_.frames[tree_[i].body]);
+        angular(force_[i]).noalias() += rotation * (Algebra::inertia(body.inertia) *
+                                                    (rotation.transpose() * angular(motion_[i])));
+        linear(force_[i]) += body.mass * linear(motion_[i]);
       }
       closure_rates(motion_, mu);
       solution_.tail(num_equations()) -= mu;
@@ -947,24 +974,24 @@ class JointCoordinates {
   template <class Motion>
   void closure_rates_of(Motion&& motion, Eigen::Ref<Eigen::VectorXd> out) const {
     out.setZero();
-    for (const detail::ClosureBlock& block : closure_blocks_)
+    for (const ClosureBlock& block : closure_blocks_)
       for (int r = 0; r < block.count; ++r)
         out[block.row + r] += block.rows.row(r).dot(motion(block.node));
   }
-  void closure_rates(const std::vector<Vector6>& motion, Eigen::Ref<Eigen::VectorXd> out) const {
-    closure_rates_of([&](int i) -> const Vector6& { return motion[i]; }, out);
+  void closure_rates(const std::vector<Motion>& motion, Eigen::Ref<Eigen::VectorXd> out) const {
+    closure_rates_of([&](int i) -> const Motion& { return motion[i]; }, out);
   }
 
   /// force += sign C^T lambda, as wrenches (global axes, at the centres).
   void add_closure_wrenches(const Eigen::Ref<const Eigen::VectorXd>& lambda, double sign,
-                            std::vector<Vector6>& force) const {
-    for (const detail::ClosureBlock& block : closure_blocks_)
+                            std::vector<Motion>& force) const {
+    for (const ClosureBlock& block : closure_blocks_)
       force[block.node].noalias() += sign * (block.rows.topRows(block.count).transpose() *
                                              lambda.segment(block.row, block.count));
   }
 
-  static void clear(std::vector<Vector6>& vectors) {
-    for (Vector6& v : vectors) v.setZero();
+  static void clear(std::vector<Motion>& vectors) {
+    for (Motion& v : vectors) v.setZero();
   }
 
   /// f(element, blocks, closure_row, model_row) for every loop-closing constraint element.
@@ -996,7 +1023,7 @@ class JointCoordinates {
     const int nb = model_.num_bodies();
     std::vector<Edge> edges;
     model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-      if constexpr (spatial::CarriesBody<E>)
+      if constexpr (Algebra::template carries_body<E>)
         for (std::size_t i = 0; i < pool.size(); ++i)
           edges.push_back(
               {type, i, pool[i].bodies()[0].index, pool[i].bodies()[1].index, E::num_equations});
@@ -1058,15 +1085,15 @@ class JointCoordinates {
       node.parent_node = node.parent == 0 ? -1 : node_of_[node.parent];
       const Edge& edge = edges[parent_edge[node.body]];
       model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-        if constexpr (spatial::CarriesBody<E>) {
+        if constexpr (Algebra::template carries_body<E>) {
           if (type != edge.type) return;
           const E& joint = pool[edge.index];
           const int parent_side = joint.bodies()[0].index == node.parent ? 0 : 1;
           const auto in = detail::input_of(joint, ws_.frames, ws_.t);
-          if constexpr (spatial::TreeJoint<E>) {
+          if constexpr (Algebra::template screw_joint<E>) {
             const auto screws = joint.tree_screws(in, parent_side);
             node.screws.assign(screws.begin(), screws.end());
-          } else {
+          } else if constexpr (spatial_model) {
             node.kind = Kind::ball;
             node.pivot = joint.tree_pivot(in, parent_side);
           }
@@ -1078,6 +1105,7 @@ class JointCoordinates {
       });
       const Frame &parent = ws_.frames[node.parent], &child = ws_.frames[node.body];
       node.rotation0 = parent.rotation.transpose() * child.rotation;
+      if constexpr (!spatial_model) node.angle0 = child.angle - parent.angle;
       node.position0 = parent.rotation.transpose() * (child.position - parent.position);
     }
     int q_offset = 0, v_offset = 0;
@@ -1109,16 +1137,14 @@ class JointCoordinates {
 
   void size_buffers() {
     const Eigen::Index n = num_velocities(), m = num_equations();
-    nodes_.assign(tree_.size(), detail::TreeNodeState{});
-    for (int slot = 0; slot < slots_; ++slot)
-      factors_[slot].assign(tree_.size(), detail::NodeFactor{});
-    own_blocks_.assign(static_cast<std::size_t>(model_.num_bodies() + 1),
-                       Spatial::MassBlock::Zero());
-    force_.assign(tree_.size(), Vector6::Zero());
+    nodes_.assign(tree_.size(), NodeState{});
+    for (int slot = 0; slot < slots_; ++slot) factors_[slot].assign(tree_.size(), NodeFactor{});
+    own_blocks_.assign(static_cast<std::size_t>(model_.num_bodies() + 1), Space::MassBlock::Zero());
+    force_.assign(tree_.size(), Motion::Zero());
     motion_ = force_;
     motion2_ = force_;
     closure_motion_ = force_;
-    constraint_force_.setZero(6 * model_.num_bodies());
+    constraint_force_.setZero(Space::nv * model_.num_bodies());
     phi_t_.setZero(m);
     velocity_values_.setZero(m);
     lambda_.setZero(m);
@@ -1148,8 +1174,8 @@ class JointCoordinates {
   void initial_state() {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free)
-        q_.segment<Spatial::nq>(node.q_offset) =
-            ws_.q.template segment<Spatial::nq>(7 * (node.body - 1));
+        q_.segment<Space::nq>(node.q_offset) =
+            ws_.q.template segment<Space::nq>(Space::nq * (node.body - 1));
       if (node.kind == Kind::ball) q_.segment<4>(node.q_offset) << 1.0, 0.0, 0.0, 0.0;
     }
     const Eigen::VectorXd velocities = ws_.v;
@@ -1165,9 +1191,10 @@ class JointCoordinates {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const int b = tree_[i].body;
       const auto& body = model_.body(BodyId{b});
-      force_[i].head<3>().noalias() =
-          -(ws_.frames[b].rotation * (body.inertia * velocities.segment<3>(6 * (b - 1) + 3)));
-      force_[i].tail<3>() = -body.mass * velocities.segment<3>(6 * (b - 1));
+      angular(force_[i]).noalias() =
+          -(Algebra::axes(ws_.frames[b]) *
+            (Algebra::inertia(body.inertia) * velocities.segment<A>(Space::nv * (b - 1) + L)));
+      linear(force_[i]) = -body.mass * velocities.segment<L>(Space::nv * (b - 1));
     }
     closure_rhs_ = -phi_t_;
     saddle_solve(true, false, closure_rhs_, v_, multiplier_);
@@ -1228,8 +1255,8 @@ class JointCoordinates {
                             Eigen::Ref<Eigen::VectorXd> change) const {
     for (const TreeBody& node : tree_) {
       if (node.kind == Kind::free) {
-        change.segment<Spatial::nq>(node.q_offset) = Spatial::configuration_rate(
-            q.segment<Spatial::nq>(node.q_offset), w.segment<Spatial::nv>(node.v_offset));
+        change.segment<Space::nq>(node.q_offset) = Space::configuration_rate(
+            q.segment<Space::nq>(node.q_offset), w.segment<Space::nv>(node.v_offset));
       } else if (node.kind == Kind::ball) {
         const auto at = q.segment<4>(node.q_offset);
         const auto rate = w.segment<3>(node.v_offset);
@@ -1249,7 +1276,7 @@ class JointCoordinates {
       const TreeBody& node = tree_[i];
       motion2_[i] = node.parent_node >= 0
                         ? shifted_motion(motion2_[node.parent_node], nodes_[i].offset)
-                        : Vector6::Zero();
+                        : Motion::Zero();
       motion2_[i].noalias() +=
           nodes_[i].motion.leftCols(node.dof()) * x.segment(node.v_offset, node.dof());
     }
@@ -1264,67 +1291,114 @@ class JointCoordinates {
   void update_kinematics() {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const TreeBody& node = tree_[i];
-      detail::TreeNodeState& state = nodes_[i];
+      NodeState& state = nodes_[i];
       Frame& frame = ws_.frames[node.body];
       const Frame& parent = ws_.frames[node.parent];
       if (node.kind == Kind::free) {
-        Spatial::make_frame(q_.segment<Spatial::nq>(node.q_offset),
-                            v_.segment<Spatial::nv>(node.v_offset), frame);
+        Space::make_frame(q_.segment<Space::nq>(node.q_offset),
+                          v_.segment<Space::nv>(node.v_offset), frame);
         // Rates (v_centre, omega in body axes): translations, then turns about the centre.
         state.motion.setZero();
-        state.motion.bottomLeftCorner<3, 3>().setIdentity();
-        state.motion.topRightCorner<3, 3>() = frame.rotation;
-      } else if (node.kind == Kind::ball) {
-        const auto quaternion = q_.segment<4>(node.q_offset);
-        const Eigen::Matrix3d axes =
-            parent.rotation *
-            Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2], quaternion[3])
-                .toRotationMatrix();
-        const Eigen::Vector3d pivot = parent.position + parent.rotation * node.pivot;
-        frame.rotation = axes * node.rotation0;
-        frame.position = pivot + axes * (node.position0 - node.pivot);
-        // Turns about the pivot, about the axes the quaternion's rates are given in.
-        const Eigen::Vector3d arm = frame.position - pivot;
-        for (int k = 0; k < 3; ++k) {
-          state.motion.col(k).head<3>() = axes.col(k);
-          state.motion.col(k).tail<3>() = axes.col(k).cross(arm);
-        }
+        state.motion.template block<L, L>(A, 0).setIdentity();
+        state.motion.template block<A, A>(0, L) = Algebra::axes(frame);
+      } else if constexpr (spatial_model) {
+        if (node.kind == Kind::ball)
+          ball_kinematics(node, parent, frame, state);
+        else
+          screw_kinematics(node, parent, frame, state);
       } else {
-        // The frame the motions so far carry: its rotation and where the parent's origin went.
-        Eigen::Matrix3d rotation = parent.rotation;
-        Eigen::Vector3d origin = parent.position;
-        std::array<Eigen::Vector3d, 6> axis, point;
-        const int count = node.dof();
-        for (int k = 0; k < count; ++k) {
-          const Screw& screw = node.screws[k];
-          const double angle = q_[node.q_offset + k];
-          axis[k] = rotation * screw.axis;
-          if (screw.kind == Screw::Kind::rotation) {
-            point[k] = origin + rotation * screw.point;
-            // Rodrigues on the right: R exp(angle [a]) = c R + s [R a] R + (1 - c) (R a) a^T.
-            const double sine = std::sin(angle), cosine = std::cos(angle);
-            for (int j = 0; j < 3; ++j) {
-              const Eigen::Vector3d column = rotation.col(j);
-              rotation.col(j) = cosine * column + sine * axis[k].cross(column) +
-                                ((1.0 - cosine) * screw.axis[j]) * axis[k];
-            }
-            origin = point[k] - rotation * screw.point;
-          } else {
-            origin += angle * axis[k];
-          }
-        }
-        frame.rotation = rotation * node.rotation0;
-        frame.position = origin + rotation * node.position0;
-        for (int k = 0; k < count; ++k) {
-          const bool turns = node.screws[k].kind == Screw::Kind::rotation;
-          state.motion.col(k).head<3>() = turns ? axis[k] : Eigen::Vector3d::Zero();
-          state.motion.col(k).tail<3>() =
-              turns ? Eigen::Vector3d(axis[k].cross(frame.position - point[k])) : axis[k];
-        }
+        planar_kinematics(node, parent, frame, state);
       }
       state.offset = frame.position - parent.position;
     }
     update_velocities();
+  }
+
+  /// A ball joint's child: turned by its quaternion about the pivot.
+  void ball_kinematics(const TreeBody& node, const Frame& parent, Frame& frame,
+                       NodeState& state) const {
+    const auto quaternion = q_.segment<4>(node.q_offset);
+    const Eigen::Matrix3d axes = parent.rotation * Eigen::Quaterniond(quaternion[0], quaternion[1],
+                                                                      quaternion[2], quaternion[3])
+                                                       .toRotationMatrix();
+    const Eigen::Vector3d pivot = parent.position + parent.rotation * node.pivot;
+    frame.rotation = axes * node.rotation0;
+    frame.position = pivot + axes * (node.position0 - node.pivot);
+    // Turns about the pivot, about the axes the quaternion's rates are given in.
+    const Eigen::Vector3d arm = frame.position - pivot;
+    for (int k = 0; k < 3; ++k) {
+      state.motion.col(k).template head<3>() = axes.col(k);
+      state.motion.col(k).template tail<3>() = axes.col(k).cross(arm);
+    }
+  }
+
+  /// A spatial screw joint's child: its product of exponentials.
+  void screw_kinematics(const TreeBody& node, const Frame& parent, Frame& frame,
+                        NodeState& state) const {
+    // The frame the motions so far carry: its rotation and where the parent's origin went.
+    Eigen::Matrix3d rotation = parent.rotation;
+    Eigen::Vector3d origin = parent.position;
+    std::array<Eigen::Vector3d, 6> axis, point;
+    const int count = node.dof();
+    for (int k = 0; k < count; ++k) {
+      const Screw& screw = node.screws[k];
+      const double angle = q_[node.q_offset + k];
+      axis[k] = rotation * screw.axis;
+      if (screw.kind == Screw::Kind::rotation) {
+        point[k] = origin + rotation * screw.point;
+        // Rodrigues on the right: R exp(angle [a]) = c R + s [R a] R + (1 - c) (R a) a^T.
+        const double sine = std::sin(angle), cosine = std::cos(angle);
+        for (int j = 0; j < 3; ++j) {
+          const Eigen::Vector3d column = rotation.col(j);
+          rotation.col(j) = cosine * column + sine * axis[k].cross(column) +
+                            ((1.0 - cosine) * screw.axis[j]) * axis[k];
+        }
+        origin = point[k] - rotation * screw.point;
+      } else {
+        origin += angle * axis[k];
+      }
+    }
+    frame.rotation = rotation * node.rotation0;
+    frame.position = origin + rotation * node.position0;
+    for (int k = 0; k < count; ++k) {
+      const bool turns = node.screws[k].kind == Screw::Kind::rotation;
+      state.motion.col(k).template head<3>() = turns ? axis[k] : Eigen::Vector3d::Zero();
+      state.motion.col(k).template tail<3>() =
+          turns ? Eigen::Vector3d(axis[k].cross(frame.position - point[k])) : axis[k];
+    }
+  }
+
+  /// A planar joint's child: its turns about points and slides, in order. Turns in the plane
+  /// commute, so the child's angle is its parent's plus the joint's angles (and the start's).
+  void planar_kinematics(const TreeBody& node, const Frame& parent, Frame& frame,
+                         NodeState& state) const {
+    double angle = parent.angle;
+    Eigen::Matrix2d rotation = parent.rotation;
+    Eigen::Vector2d origin = parent.position;
+    std::array<Eigen::Vector2d, D> axis, point;
+    const int count = node.dof();
+    for (int k = 0; k < count; ++k) {
+      const Screw& screw = node.screws[k];
+      const double coordinate = q_[node.q_offset + k];
+      axis[k] = rotation * screw.axis;
+      if (screw.kind == Screw::Kind::rotation) {
+        point[k] = origin + rotation * screw.point;
+        angle += coordinate;
+        rotation = Space::rotation(angle);
+        origin = point[k] - rotation * screw.point;
+      } else {
+        origin += coordinate * axis[k];
+      }
+    }
+    frame.angle = angle + node.angle0;
+    frame.rotation = Space::rotation(frame.angle);
+    frame.position = origin + rotation * node.position0;
+    for (int k = 0; k < count; ++k) {
+      const bool turns = node.screws[k].kind == Screw::Kind::rotation;
+      state.motion(0, k) = turns ? 1.0 : 0.0;
+      state.motion.col(k).template tail<2>() =
+          turns ? Eigen::Vector2d(Space::perpendicular(frame.position - point[k])) : axis[k];
+    }
   }
 
   /// Down the tree: twists V = V_parent (at this centre) + S theta', the joints' c and the
@@ -1335,30 +1409,30 @@ class JointCoordinates {
   void update_velocities() {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const TreeBody& node = tree_[i];
-      detail::TreeNodeState& state = nodes_[i];
+      NodeState& state = nodes_[i];
       Frame& frame = ws_.frames[node.body];
-      Vector6 twist = node.parent_node >= 0
-                          ? shifted_motion(nodes_[node.parent_node].twist, state.offset)
-                          : Vector6::Zero();
+      Motion twist = node.parent_node >= 0
+                         ? shifted_motion(nodes_[node.parent_node].twist, state.offset)
+                         : Motion::Zero();
       state.bias.setZero();
       const auto rates = v_.segment(node.v_offset, node.dof());
       if (node.kind == Kind::free) {
         twist.noalias() = state.motion * rates;
-        state.bias.tail<3>() = twist.tail<3>().cross(twist.head<3>());
+        linear(state.bias) = -Algebra::turn(angular(twist), linear(twist));
       } else if (node.kind == Kind::ball) {
-        const Vector6 relative = state.motion.leftCols<3>() * rates;
-        state.bias = motion_cross(twist, relative);
+        const Motion relative = state.motion.template leftCols<3>() * rates;
+        state.bias = Algebra::motion_cross(twist, relative);
         twist += relative;
       } else {
         for (int k = 0; k < node.dof(); ++k) {
-          const Vector6 column = state.motion.col(k);
-          state.bias += motion_cross(twist, column) * rates[k];
+          const Motion column = state.motion.col(k);
+          state.bias += Algebra::motion_cross(twist, column) * rates[k];
           twist += column * rates[k];
         }
       }
       state.twist = twist;
-      frame.angular_velocity.noalias() = frame.rotation.transpose() * twist.head<3>();
-      frame.linear_velocity = twist.tail<3>();
+      frame.angular_velocity.noalias() = Algebra::axes(frame).transpose() * angular(twist);
+      frame.linear_velocity = linear(twist);
     }
   }
 
@@ -1367,14 +1441,14 @@ class JointCoordinates {
   std::vector<TreeBody> tree_;  // parents before children
   std::vector<int> node_of_;    // body index -> place in tree_ (-1: the ground)
   std::array<std::vector<Closure>, Model::num_types> closures_;
-  std::vector<detail::ClosureBlock> closure_blocks_;
+  std::vector<ClosureBlock> closure_blocks_;
   std::vector<std::string> tree_names_, closure_names_;
 
-  std::vector<detail::TreeNodeState> nodes_;
-  std::vector<typename Spatial::MassBlock> own_blocks_;  // per body: see add_own_force_blocks
-  std::vector<Vector6> force_;                           // per node: p in a solve (scratch)
-  std::vector<Vector6> motion_, motion2_;                // per node: J x (+ c) of a solve (scratch)
-  std::vector<Vector6> closure_motion_;                  // per node: saddle_solve's own scratch
+  std::vector<NodeState> nodes_;
+  std::vector<typename Space::MassBlock> own_blocks_;  // per body: see add_own_force_blocks
+  std::vector<Motion> force_;                          // per node: p in a solve (scratch)
+  std::vector<Motion> motion_, motion2_;               // per node: J x (+ c) of a solve (scratch)
+  std::vector<Motion> closure_motion_;                 // per node: saddle_solve's own scratch
 
   Eigen::VectorXd q_, v_;             // (nq), (n) joint coordinates and rates
   Eigen::VectorXd constraint_force_;  // (6 nb) Phi_q^T lambda, in complete_workspace()
@@ -1387,8 +1461,8 @@ class JointCoordinates {
   Eigen::MatrixXd kkt_;               // (n + m) [A C^T; C 0], lower triangle (dense_)
   std::array<SaddlePointLdlt, max_slots> kkt_ldlts_;  // its factorization, per slot
   Eigen::VectorXd solution_;  // (n + m) right-hand side, then solution (dense_)
-  std::array<Eigen::LLT<Eigen::MatrixXd>, max_slots> schur_llts_;   // the Schur's, per slot
-  std::array<std::vector<detail::NodeFactor>, max_slots> factors_;  // A's, per slot and node
+  std::array<Eigen::LLT<Eigen::MatrixXd>, max_slots> schur_llts_;  // the Schur's, per slot
+  std::array<std::vector<NodeFactor>, max_slots> factors_;         // A's, per slot and node
   int slots_ = 1, slot_ = 0;  // the slots in use; the one factorized or solved with last
   Eigen::VectorXd increment_, increment2_;  // (n) scratch
   Eigen::VectorXd closure_step_;            // (n) saddle_solve's own scratch

@@ -579,7 +579,7 @@ class GeneralizedAlphaMethod {
 template <class Model, class Solver = BlockSchurSaddlePoint<Model>>
 using GeneralizedAlpha = GeneralizedAlphaMethod<Model, AbsoluteCoordinates<Model, Solver>>;
 
-/// Generalized-alpha (and HHT) in joint coordinates (spatial models).
+/// Generalized-alpha (and HHT) in joint coordinates.
 template <class Model>
 using JointGeneralizedAlpha = GeneralizedAlphaMethod<Model, JointCoordinates<Model>>;
 

@@ -4,6 +4,7 @@
 
 #include "odyn/planar/pair_joint.hpp"
 #include "odyn/planar/primitives.hpp"
+#include "odyn/planar/screw.hpp"
 
 namespace odyn::planar {
 
@@ -11,6 +12,10 @@ class Fixed : public PairJoint {
  public:
   static constexpr int num_equations = 3;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 0;
+
+  /// As a tree joint: the child moves with its parent.
+  std::array<Screw, 0> tree_screws(const Input&, int) const { return {}; }
 
   void evaluate(const Input& in, BlocksOf<Fixed>& out) const {
     primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
@@ -33,5 +38,6 @@ class Fixed : public PairJoint {
   }
 };
 static_assert(Constraint<Fixed>);
+static_assert(TreeJoint<Fixed>);
 
 }  // namespace odyn::planar

@@ -4,6 +4,7 @@
 
 #include "odyn/planar/pair_joint.hpp"
 #include "odyn/planar/primitives.hpp"
+#include "odyn/planar/screw.hpp"
 
 namespace odyn::planar {
 
@@ -11,6 +12,12 @@ class Revolute : public PairJoint {
  public:
   static constexpr int num_equations = 2;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 1;
+
+  /// As a tree joint: the child turns about the parent's point.
+  std::array<Screw, 1> tree_screws(const Input&, int parent_side) const {
+    return {Screw{Screw::Kind::rotation, Eigen::Vector2d::UnitX(), frame(parent_side).point}};
+  }
 
   void evaluate(const Input& in, BlocksOf<Revolute>& out) const {
     primitive::coincident(in.body(0), on_a_.point, in.body(1), on_b_.point, out, 0);
@@ -27,5 +34,6 @@ class Revolute : public PairJoint {
   }
 };
 static_assert(Constraint<Revolute>);
+static_assert(TreeJoint<Revolute>);
 
 }  // namespace odyn::planar

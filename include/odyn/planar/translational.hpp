@@ -8,6 +8,7 @@
 
 #include "odyn/planar/pair_joint.hpp"
 #include "odyn/planar/primitives.hpp"
+#include "odyn/planar/screw.hpp"
 
 namespace odyn::planar {
 
@@ -15,6 +16,15 @@ class Translational : public PairJoint {
  public:
   static constexpr int num_equations = 2;
   using PairJoint::PairJoint;
+  static constexpr int degrees_of_freedom = 1;
+
+  /// As a tree joint: the child slides along a's axis, which keeps its direction in the parent's
+  /// coordinates (the bodies do not turn relative to each other).
+  std::array<Screw, 1> tree_screws(const Input& in, int parent_side) const {
+    const Eigen::Vector2d along =
+        in.body(parent_side).rotation.transpose() * in.body(0).direction(on_a_.axis);
+    return {Screw{Screw::Kind::translation, along, frame(parent_side).point}};
+  }
 
   void bind(const Input& in) {
     PairJoint::bind(in);
@@ -51,5 +61,6 @@ class Translational : public PairJoint {
   double held_angle_ = 0.0;  // 0 or a multiple of pi
 };
 static_assert(Constraint<Translational>);
+static_assert(TreeJoint<Translational>);
 
 }  // namespace odyn::planar
