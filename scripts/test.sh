@@ -28,7 +28,10 @@ bash scripts/setup.sh --no-package
 # Template instantiation makes each translation unit cost tens of seconds of CPU, so the builds
 # run side by side. The longest chain is the sanitizer build (one unity unit: its files share
 # their models and integrators) and its test run; the rest builds beside it at a lower priority,
-# so that it fills the other core without slowing that chain.
+# one unit at a time (the Python package, then the examples), so that it fills the other core
+# without slowing that chain. One at a time, because memory is the other limit: the sanitizer
+# unit alone takes some 15 GB, each other unit 3 to 4 GB, and a machine that runs out of memory
+# does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -42,7 +45,7 @@ finish() {
 section "Beside the sanitizer build: the Python package, the Release examples, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh >"$python_log" 2>&1 &
+CMAKE_BUILD_PARALLEL_LEVEL=1 nice -n 10 bash scripts/setup.sh >"$python_log" 2>&1 &
 python_pid=$!
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
@@ -51,7 +54,8 @@ rm -rf build/install build/downstream
 cmake --install build --prefix build/install >/dev/null
 release_log=build/release.log
 (
-  nice -n 10 cmake --build build -j "$jobs" --target engine slider_crank_planar four_bar andrews
+  while kill -0 "$python_pid" 2>/dev/null; do sleep 5; done  # after the Python package's units
+  nice -n 10 cmake --build build -j 1 --target engine slider_crank_planar four_bar andrews
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \

@@ -717,7 +717,8 @@ namespace {
 
 namespace pl = odyn::planar;
 using Eigen::Vector2d;
-using PlanarModel = pl::Model<pl::Revolute, pl::Translational, pl::Distance, pl::Gravity, pl::Tsda>;
+// The library's planar model type, which other tests simulate too: no further instantiation.
+using PlanarModel = pl::DefaultModel;
 
 /// Every planar tree-joint kind and a free root at once: a cart sliding on an inclined track
 /// (translational), a pendulum hinged to it with a spring to the cart, a loose body tied to
