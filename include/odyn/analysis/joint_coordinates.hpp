@@ -1391,7 +1391,7 @@ class JointCoordinates {
       }
     }
     frame.angle = angle + node.angle0;
-    frame.rotation = Space::rotation(frame.angle);
+    frame.rotation = rotation * node.rotation0;  // the angle's rotation, with no more sines
     frame.position = origin + rotation * node.position0;
     for (int k = 0; k < count; ++k) {
       const bool turns = node.screws[k].kind == Screw::Kind::rotation;
