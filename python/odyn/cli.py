@@ -121,6 +121,9 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
                      f"factorizations {s['factorizations']}")
         lines.append(f"  largest local error estimate {s['max_error_estimate']:.3g} "
                      "(in units of rtol, atol)")
+        if s.get("singular_steps"):
+            lines.append(f"  {s['singular_steps']} steps ended near a singular configuration "
+                         "(constraint Jacobian nearly rank-deficient; see docs/hard-cases.md)")
         stepping = s["wall_seconds"] - s["setup_seconds"]
         lines.append(f"  wall time {s['wall_seconds']:.3f} s: setup {s['setup_seconds']:.3f} s, "
                      f"steps {stepping:.3f} s ({1e6 * stepping / max(steps, 1):.2f} us per step)")

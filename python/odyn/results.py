@@ -55,6 +55,7 @@ class Statistics(NamedTuple):
     residual_evaluations: int   # evaluations of Phi, Phi_q and Q together
     restarts: int               # after discontinuities and at the start
     events: int                 # located switches of force laws
+    singular_steps: int         # steps that ended at a singular configuration's rounding floor
     max_error_estimate: float   # largest local error estimate of a step, in units of rtol/atol
     outputs: int
     wall_seconds: float         # the whole run

@@ -239,6 +239,7 @@ inline py::dict run_summary(const RunSummary& s) {
   d["rejected_steps"] = st.rejected_steps;
   d["restarts"] = st.restarts;
   d["events"] = st.events;
+  d["singular_steps"] = st.singular_steps;
   d["max_error_estimate"] = st.max_error_estimate;
   d["outputs"] = s.outputs;
   d["wall_seconds"] = s.wall_seconds;

@@ -357,3 +357,52 @@ def test_planar_engine_in_joint_coordinates():
     errors = [np.max(np.abs(scene.simulate(t_end=0.1, step=step, coordinates="joint")
                             .body("crank").angle - crank)) for step in (2e-4, 1e-4)]
     assert 3.5 < errors[0] / errors[1] < 4.5, errors
+
+
+def parallelogram_chain(n, angle=0.5, r=0.15, d=0.4, crank_mass=0.5, coupler_mass=1.2):
+    """n parallelogram four-bars in a row (examples/parallelogram_chain_model.hpp): n + 1
+    cranks hinged to the ground at (i d, 0), n couplers joining their tips, at rest."""
+    m = odyn.PlanarModel()
+    c, s = math.cos(angle), math.sin(angle)
+    for i in range(n + 1):
+        m.add_body(f"crank {i}", crank_mass, crank_mass * r * r / 12,
+                   position=(i * d + r * c / 2, r * s / 2), angle=angle)
+        m.add_revolute(f"O{i}", body_a="ground", body_b=f"crank {i}",
+                       on_a=odyn.frame([i * d, 0]), on_b=odyn.frame([-r / 2, 0]))
+    for j in range(n):
+        m.add_body(f"coupler {j}", coupler_mass, coupler_mass * d * d / 12,
+                   position=((j + 0.5) * d + r * c, r * s))
+        m.add_revolute(f"A{j}", body_a=f"crank {j}", body_b=f"coupler {j}",
+                       on_a=odyn.frame([r / 2, 0]), on_b=odyn.frame([-d / 2, 0]))
+        m.add_revolute(f"B{j}", body_a=f"coupler {j}", body_b=f"crank {j + 1}",
+                       on_a=odyn.frame([d / 2, 0]), on_b=odyn.frame([r / 2, 0]))
+    m.add_gravity("gravity", (0, -G))
+    return m
+
+
+def test_a_chain_of_parallelograms_passes_its_singular_configurations_with_the_defaults():
+    # Every link on the ground line twice a half period: Phi_q loses n ranks for an instant.
+    # The defaults (generalized-alpha, h = 1e-4) must pass the crossings on the parallelogram
+    # branch, the crank following the minimal-coordinate pendulum J theta'' = -G cos theta.
+    n, r, d, mc, mp = 6, 0.15, 0.4, 0.5, 1.2
+    result = odyn.simulate(parallelogram_chain(n), t_end=1.0, output_interval=0.01)
+    inertia = (n + 1) * mc * r * r / 3 + n * mp * r * r
+    moment = G * ((n + 1) * mc * r / 2 + n * mp * r)
+    theta, omega, h, reference = 0.5, 0.0, 1e-4, [0.5]
+    for _ in range(100):  # RK4 at 1e-4 s between outputs (error ~1e-10 rad)
+        for _ in range(100):
+            k1 = (omega, -moment / inertia * math.cos(theta))
+            k2 = (omega + h / 2 * k1[1], -moment / inertia * math.cos(theta + h / 2 * k1[0]))
+            k3 = (omega + h / 2 * k2[1], -moment / inertia * math.cos(theta + h / 2 * k2[0]))
+            k4 = (omega + h * k3[1], -moment / inertia * math.cos(theta + h * k3[0]))
+            theta += h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+            omega += h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        reference.append(theta)
+    reference = np.array(reference)
+    assert np.sum(np.diff(np.floor(reference / math.pi)) != 0) == 4  # four crossings
+    np.testing.assert_allclose(result.body("crank 0").angle, reference, atol=3e-5)
+    for i in range(1, n + 1):  # every crank at crank 0's angle: the branch kept
+        np.testing.assert_allclose(result.body(f"crank {i}").angle,
+                                   result.body("crank 0").angle, atol=1e-8)
+    # Some steps ended at a crossing's rounding floor, and the statistics say so.
+    assert result.statistics.singular_steps > 0 and result.statistics.rejected_steps == 0

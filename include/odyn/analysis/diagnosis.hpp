@@ -1,15 +1,19 @@
 #pragma once
 // What to tell a user when Newton fails: the force element that returned NaN or pushes
-// hardest, and the joint with the largest constraint residual, read from the workspace's last
-// evaluation. Shared by the implicit integrators' error messages.
+// hardest, the joint with the largest constraint residual, and a constraint Jacobian that
+// momentarily loses rank (a singular configuration), read from the workspace's last evaluation.
+// Shared by the integrators' error messages.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <string>
 #include <vector>
 
+#include "odyn/analysis/assembly.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/workspace.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 
 namespace odyn::diagnosis {
 
@@ -58,6 +62,45 @@ std::string worst_constraint(const Model& model, const Workspace<Model>& ws) {
   const double worst = ws.phi.cwiseAbs().maxCoeff(&row);
   return "largest constraint residual " + to_text(worst) + " at '" +
          model.constraint_name(static_cast<int>(row)) + "'";
+}
+
+/// Below this ratio to the largest pivot of a rank-revealing QR of Phi_q^T, an equation counts
+/// as lost for the moment (a singular configuration); below rank_tolerance, as lost for good (an
+/// equation that repeats others, reported by the assembly).
+inline constexpr double near_rank_loss = 1e-4;
+
+/// " The constraint Jacobian nearly loses rank here: ..." when Phi_q at the workspace's pose has
+/// pivots between the exactly repeated equations' (relative rank_tolerance) and near_rank_loss
+/// of the largest: a singular configuration, where the mechanism can move in more ways for an
+/// instant and its branches cross (and its reactions grow without bound). Names the joints of
+/// the equations pivoted last. Empty otherwise, and for models too large for a dense
+/// factorization at the moment of failure.
+template <class Model>
+std::string rank_drop(const Model& model, const Workspace<Model>& ws) {
+  const int m = model.num_equations(), n = model.num_velocities();
+  if (m == 0 || static_cast<double>(m) * m * n > 1e10) return {};
+  const Eigen::MatrixXd transposed = detail::dense_jacobian(model, ws).transpose();
+  if (!transposed.allFinite()) return {};
+  const RankRevealingQr exact(transposed, rank_tolerance);
+  const RankRevealingQr near(transposed, near_rank_loss);
+  const auto rank = exact.rank(), near_rank = near.rank();
+  if (near_rank >= rank) return {};
+  std::vector<std::string> joints;
+  for (Eigen::Index k = near_rank; k < rank; ++k) {
+    const int row = near.column_order()[static_cast<std::size_t>(k)];
+    const std::string name = detail::locate_row(model, row).joint;
+    if (std::find(joints.begin(), joints.end(), name) == joints.end()) joints.push_back(name);
+  }
+  std::string names;
+  constexpr std::size_t shown = 8;
+  for (std::size_t i = 0; i < std::min(joints.size(), shown); ++i)
+    names += (i > 0 ? ", '" : "'") + joints[i] + "'";
+  if (joints.size() > shown) names += " and " + std::to_string(joints.size() - shown) + " more";
+  return " The constraint Jacobian nearly loses rank here: rank " + std::to_string(rank) +
+         " drops to " + std::to_string(near_rank) + " within " + to_text(near_rank_loss) +
+         " of its largest pivot (equations of " + names +
+         "): a singular configuration, where the mechanism can move in more ways for an instant "
+         "and its branches cross.";
 }
 
 }  // namespace odyn::diagnosis

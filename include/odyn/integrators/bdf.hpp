@@ -578,15 +578,30 @@ class BdfMethod {
     }
   }
 
-  std::string failure_message() const {
+  /// diagnosis::rank_drop at the workspace's state (in joint coordinates, after filling in
+  /// every joint's blocks there): what to say about a singular configuration, if it is one.
+  std::string singular_configuration() {
+    if constexpr (requires(Coordinates & c) { c.complete_workspace(); })
+      coordinates_.complete_workspace();
+    return diagnosis::rank_drop(model_, ws_);
+  }
+
+  std::string failure_message() {
     if (!all_finite(rhs_) || !all_finite(ws_.force))
       return "bdf: Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
-    return "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
-           " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) + " s (" +
-           diagnosis::worst_constraint(model_, ws_) + diagnosis::strongest_force(model_, ws_) +
-           "). Check the force elements' parameters, or look for a locked or singular mechanism.";
+    const std::string singular = singular_configuration();
+    const std::string head =
+        "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
+        " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) + " s (" +
+        diagnosis::worst_constraint(model_, ws_) + diagnosis::strongest_force(model_, ws_) + ").";
+    if (!singular.empty())
+      return head + singular +
+             " bdf's iteration does not pass such configurations yet; generalized-alpha "
+             "(integrator 'generalized-alpha') steps through them.";
+    return head +
+           " Check the force elements' parameters, or look for a locked or singular mechanism.";
   }
 
   // The coordinates' factorization slots.

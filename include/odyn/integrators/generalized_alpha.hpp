@@ -99,6 +99,8 @@ class GeneralizedAlphaMethod {
     const int n = nv_total_ + m_;
     residual_ = Eigen::VectorXd::Zero(n);
     correction_ = Eigen::VectorXd::Zero(n);
+    probe_ = Eigen::VectorXd::Zero(n);
+    probe_correction_ = Eigen::VectorXd::Zero(n);
     increment_ = Eigen::VectorXd::Zero(nv_total_);
     jerk_ = Eigen::VectorXd::Zero(nv_total_);
     a_step_ = Eigen::VectorXd::Zero(nv_total_);
@@ -413,6 +415,7 @@ class GeneralizedAlphaMethod {
     bool ordinary_met = false;
     int refreshes = 0;
     factorized_at_ = -1;  // the iterate of the matrix in use: before this step
+    rounding_floor_ = -1.0;
     for (int k = 0; k <= settings_.max_iterations; ++k) {
       if (!evaluate_residual()) return false;
       const double phi_norm =
@@ -429,9 +432,30 @@ class GeneralizedAlphaMethod {
       const bool tight = previous_norm <= 1.0 || next_norm <= 1.0;
       const bool stalled =
           k == settings_.max_iterations || (k > 1 && previous_norm > 0.5 * earlier_norm);
-      if (k > 0 && (tight || (stalled && previous_norm * loose <= 1.0)) &&
-          phi_norm <= settings_.constraint_tolerance) {
+      const bool phi_met = phi_norm <= settings_.constraint_tolerance;
+      if (k > 0 && (tight || (stalled && previous_norm * loose <= 1.0)) && phi_met) {
         if ((tight ? k : ordinary_iterations) > settings_.reuse_iterations) factorized_ = false;
+        return true;
+      }
+      // At a singular configuration the corrections stall above both tolerances, at the floor
+      // that Phi's rounding sets (see rounding_floor): the step has converged as far as double
+      // precision can tell.
+      if (k > 1 && stalled && phi_met && within_rounding_floor(previous_norm, tolerance, k)) {
+        ++statistics_.singular_steps;
+        factorized_ = false;
+        return true;
+      }
+      // With redundant constraints the solver decides the rank at every factorization, and a
+      // singular configuration adds rows that it finds dependent for a while: their part of Phi
+      // (the distance to the other branch, about sigma times the step's error) is left as it is
+      // until the rank comes back. Converged corrections with Phi stalled a little above its
+      // tolerance are that.
+      if (k > 1 && stalled && coordinates_.rank_deficiency() > 0 &&
+          (previous_norm * loose <= 1.0 || within_rounding_floor(previous_norm, tolerance, k)) &&
+          phi_norm > 0.5 * previous_phi_norm &&
+          phi_norm <= stalled_phi_factor * settings_.constraint_tolerance) {
+        ++statistics_.singular_steps;
+        factorized_ = false;
         return true;
       }
       if (k == settings_.max_iterations) return false;
@@ -451,7 +475,9 @@ class GeneralizedAlphaMethod {
         ++ordinary_iterations;
         ordinary_met = norm * loose <= 1.0;
       }
-      if (k > 0 && norm > 2.0 * previous_norm && norm * loose > 1.0) return false;  // diverging
+      if (k > 0 && norm > 2.0 * previous_norm && norm * loose > 1.0 &&
+          !within_rounding_floor(norm, tolerance, k + 1))
+        return false;  // diverging
       update_state(t_new);
       const double rate = k > 0 ? norm / previous_norm : 0.0;
       // Newton contracts the correction by about rate = norm / previous_norm per iteration, so
@@ -495,6 +521,49 @@ class GeneralizedAlphaMethod {
     return false;
   }
 
+  /// How far below the tolerance (`tolerance`, absolute) Newton's velocity corrections can fall
+  /// at all: the velocity correction that a rounding-sized error of Phi alone produces through
+  /// the iteration matrix, in units of the tolerance. Away from singular configurations it is
+  /// about eps |q| / h, far below the tolerances. Where Phi_q's smallest singular value sigma
+  /// nearly vanishes (a parallelogram's change point, any mechanism whose mobility jumps for an
+  /// instant) the position along the extra mobility is fixed by Phi only to eps |q| / sigma,
+  /// and the floor rises by 1/sigma above every tolerance. Measured by one solve with a
+  /// right-hand side of Phi's rounding (signs that vary from row to row, so that it has a part
+  /// along every direction), at most once a step.
+  double rounding_floor(double tolerance, int iterate) {
+    if (rounding_floor_ >= 0.0) return rounding_floor_;
+    rounding_floor_ = 0.0;
+    if (m_ == 0) return rounding_floor_;
+    if (!factorized_) {
+      if (!factorize()) return rounding_floor_;
+      factorized_at_ = iterate;
+    }
+    const double phi_rounding = std::numeric_limits<double>::epsilon() *
+                                std::max(coordinates_.largest_position(), 1.0) / position_factor();
+    probe_.head(nv_total_).setZero();
+    for (int i = 0; i < m_; ++i)  // a fixed scramble of signs (Knuth's multiplicative hash)
+      probe_[nv_total_ + i] =
+          ((static_cast<unsigned>(i) * 2654435761u) & 0x10000u) != 0 ? phi_rounding : -phi_rounding;
+    coordinates_.solve(probe_, probe_correction_);
+    rounding_floor_ =
+        velocity_factor() * probe_correction_.head(nv_total_).cwiseAbs().maxCoeff() / tolerance;
+    if (!std::isfinite(rounding_floor_)) rounding_floor_ = 0.0;
+    return rounding_floor_;
+  }
+
+  /// A correction of this size (in units of the tolerance) is rounding noise of a nearly
+  /// singular iteration matrix (see rounding_floor); only checked once the iteration stalls.
+  bool within_rounding_floor(double norm, double tolerance, int iterate) {
+    return norm <= rounding_floor_factor * rounding_floor(tolerance, iterate);
+  }
+
+  /// Corrections up to this multiple of the rounding floor count as noise: a rounding error of
+  /// the size eps |q| in every entry of Phi is a typical one, not the largest.
+  static constexpr double rounding_floor_factor = 10.0;
+
+  /// How far above constraint_tolerance Phi may stall while the rank is momentarily lower.
+  static constexpr double stalled_phi_factor = 100.0;
+
   struct NewtonTolerance {
     double ordinary;  // atol + rtol max|v|, from the settings (or a few times the rounding)
     double tight;     // no larger: what the step's own accuracy asks for
@@ -525,14 +594,23 @@ class GeneralizedAlphaMethod {
     return {ordinary, std::min(ordinary, std::max(following, rounding))};
   }
 
-  std::string failure_message() const {
+  /// diagnosis::rank_drop at the workspace's state (in joint coordinates, after filling in
+  /// every joint's blocks there): what to say about a singular configuration, if it is one.
+  std::string singular_configuration() {
+    if constexpr (requires(Coordinates & c) { c.complete_workspace(); })
+      coordinates_.complete_workspace();
+    return diagnosis::rank_drop(model_, ws_);
+  }
+
+  std::string failure_message() {
     if (!all_finite(residual_))
       return "Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
+    const std::string singular = singular_configuration();
     return "Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
            " iterations (" + diagnosis::worst_constraint(model_, ws_) +
-           diagnosis::strongest_force(model_, ws_) + "). " +
+           diagnosis::strongest_force(model_, ws_) + ")." + singular + " " +
            (settings_.adaptive
                 ? std::string("Tighten rtol/atol or lower max_step, ")
                 : "Reduce the step size (h = " + to_text(h_) +
@@ -560,6 +638,8 @@ class GeneralizedAlphaMethod {
 
   Eigen::VectorXd residual_;                             // (n)
   Eigen::VectorXd correction_;                           // (n)
+  Eigen::VectorXd probe_, probe_correction_;             // (n) for rounding_floor
+  double rounding_floor_ = -1.0;                         // this step's; < 0: not measured yet
   Eigen::VectorXd q_n_, v_n_, vdot_n_, a_n_, lambda_n_;  // state at the start of the step
   Eigen::VectorXd vdot_previous_, lambda_previous_;      // one step earlier, for the predictor
   double previous_step_ = 0.0;                           // its size; 0 after a (re)start

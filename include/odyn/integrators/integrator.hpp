@@ -36,6 +36,9 @@ struct IntegratorStatistics {
   long residual_evaluations = 0;  // evaluations of Phi, Phi_q and Q together
   long restarts = 0;              // after discontinuities and at the start
   long events = 0;                // located switches of force laws
+  /// Steps whose Newton iteration ended at the rounding floor of a nearly singular constraint
+  /// Jacobian (a singular configuration: see GeneralizedAlphaMethod::rounding_floor).
+  long singular_steps = 0;
   /// Largest local error estimate of an accepted step, in units of the tolerance (rtol, atol);
   /// a fixed-step run reports it too, against the tolerances it was given.
   double max_error_estimate = 0.0;
