@@ -57,6 +57,13 @@ struct GeneralizedAlphaSettings {
   double max_growth = 1.2;
   /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
   LinearSolver linear_solver = LinearSolver::automatic;
+  /// At output times, v' and lambda (and so every reaction and driver effort) solved from the
+  /// index-1 equations [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the step's q and v,
+  /// rather than the step's own. The index-3 step's lambda carries errors of its Newton
+  /// iteration and of the start, which grow as h shrinks (the multipliers' part of its
+  /// iteration matrix scales as 1/h^2); these follow q and v, at second order. One more
+  /// factorization per output, in a slot of its own.
+  bool consistent_outputs = true;
 };
 
 template <class Model, class Coordinates = AbsoluteCoordinates<Model>>
@@ -72,7 +79,7 @@ class GeneralizedAlphaMethod {
         settings_(settings),
         control_(control),
         proposed_step_(std::min(control.first_step, control.max_step)),
-        coordinates_(model, ws, settings.linear_solver) {
+        coordinates_(model, ws, settings.linear_solver, settings.consistent_outputs ? 2 : 1) {
     if (settings.adaptive &&
         (!(control.rtol > 0.0) || !(control.atol > 0.0) || !(proposed_step_ > 0.0)))
       throw ModelError(settings.hht ? "hht" : "generalized-alpha",
@@ -251,11 +258,21 @@ class GeneralizedAlphaMethod {
   /// step was accepted on Newton's contraction estimate and left them one iterate behind.
   /// In joint coordinates, also fills in the workspace as an absolute-coordinate run leaves it
   /// (q, v, v', every joint's lambda; see JointCoordinates::complete_workspace).
+  /// With consistent_outputs, then solves v' and lambda there from the index-1 equations (the
+  /// step's own stay in the integrator: the next step starts from them).
   void refresh_blocks() {
     if (blocks_stale_) {
       coordinates_.evaluate_constraints();
       coordinates_.evaluate_forces();
       blocks_stale_ = false;
+    }
+    if (settings_.consistent_outputs && m_ > 0) {
+      ++statistics_.factorizations;
+      if (!coordinates_.factorize(IterationFactors{}, output_slot) ||
+          !coordinates_.solve_accelerations(output_slot)) {
+        coordinates_.accelerations() = vdot_n_;  // singular here: the step's own
+        coordinates_.multipliers() = lambda_n_;
+      }
     }
     if constexpr (requires { coordinates_.complete_workspace(); })
       coordinates_.complete_workspace();
@@ -371,6 +388,8 @@ class GeneralizedAlphaMethod {
     error_ =
         weighted_rms_norm(local_error_, error_scale_, error_scale_, control_.rtol, control_.atol);
   }
+
+  static constexpr int output_slot = 1;  // the factorization of consistent_outputs
 
   /// Newton contraction per iteration above which a matrix factorized at an earlier iterate is
   /// refreshed (see solve_step).
