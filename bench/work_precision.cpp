@@ -98,7 +98,7 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
     for (double h : steps) ladder.push_back({"adams 6, fixed h", "adams", false, 2.0 * h});
   for (double tol : loose)
     ladder.push_back({"generalized-alpha, adaptive", "generalized-alpha", true, tol});
-  for (const std::string name : {"dopri5", "dop853", "bdf"})
+  for (const std::string name : {"dopri5", "dop853", "bdf", "auto"})
     if (known_integrator(name))
       for (double tol : tight) ladder.push_back({name, name, true, tol});
   if (joint_coordinates) {  // the same methods on a spanning tree's joint coordinates

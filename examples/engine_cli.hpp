@@ -32,15 +32,15 @@ inline double number(const std::string& program, const char* option, const char*
 template <class Build>
 int run_command_line(const std::string& program, Build build, int argc, char** argv) {
   odyn::DynamicsSettings settings;
+  settings.integrator = "generalized-alpha";  // the paper's method, at --h (1e-4 s)
   std::string out_path = program + ".csv";
   const auto usage = [&] {
-    std::cerr
-        << "usage: " << program
-        << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
-           "       [--integrator generalized-alpha|hht|dopri5|dop853|bdf|adams] [--rho-inf R]\n"
-           "       [--order K (adams, 1 to 6)] [--rtol R] [--atol A]   (error control: --h is then "
-           "the first step)\n"
-           "       [--coordinates absolute|joint]\n";
+    std::cerr << "usage: " << program
+              << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
+                 "       [--integrator generalized-alpha|hht|auto|dopri5|dop853|bdf|adams]\n"
+                 "       [--rho-inf R] [--order K (adams, 1 to 6)] [--rtol R] [--atol A]\n"
+                 "       [--coordinates absolute|joint]\n"
+                 "(with --rtol/--atol, error control: --h is then the first step)\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
   for (int i = 1; i < argc; ++i) {
@@ -101,8 +101,10 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
     });
     const auto& stats = summary.statistics;
     std::printf("%s: %s, h = %g s, t_end = %g s -> %s (%ld rows)\n", program.c_str(),
-                settings.integrator.c_str(), settings.step, settings.t_end, out_path.c_str(),
+                summary.integrator.c_str(), settings.step, settings.t_end, out_path.c_str(),
                 summary.outputs);
+    if (!summary.integrator_choice.empty())
+      std::printf("  %s\n", summary.integrator_choice.c_str());
     std::printf("  %d coordinates, %d constraint equations in absolute coordinates%s\n",
                 e.model.num_velocities(), e.model.num_equations(),
                 settings.coordinates == "joint" ? "; stepped in joint coordinates" : "");

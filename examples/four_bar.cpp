@@ -12,7 +12,8 @@
 #include "four_bar_model.hpp"
 
 int main(int argc, char** argv) {
-  odyn::DynamicsSettings settings{.step = 1e-3, .t_end = 2.0, .output_interval = 1e-2};
+  odyn::DynamicsSettings settings{
+      .step = 1e-3, .t_end = 2.0, .output_interval = 1e-2, .integrator = "generalized-alpha"};
   // Joint forces are an output here: rho_inf = 0.5 damps the step-to-step ripple that index-3
   // multipliers carry at the default 0.9.
   settings.generalized_alpha.rho_inf = 0.5;

@@ -17,6 +17,7 @@ struct Parameters {
   double mass = 1.0;                        // kg, each block
   double soft = 100.0;                      // N/m, ground - block 1
   double stiff = 1e8;                       // N/m, block 1 - block 2
+  double stiff_damping = 0.0;               // N s/m, beside the stiff spring
   double spacing = 1.0;                     // m, free length of each spring
   double displacement1 = 0.0;               // m, initial, from rest
   double displacement2 = 0.0;               // m
@@ -48,8 +49,9 @@ inline Chain build(const Parameters& p = {}) {
                                 {{0.0, 0.0}, x_axis}));
   c.model.add(pl::Tsda("soft spring", odyn::ground, {0.0, 0.0}, c.first, {0.0, 0.0},
                        {.stiffness = p.soft, .free_length = p.spacing}));
-  c.model.add(pl::Tsda("stiff spring", c.first, {0.0, 0.0}, c.second, {0.0, 0.0},
-                       {.stiffness = p.stiff, .free_length = p.spacing}));
+  c.model.add(
+      pl::Tsda("stiff spring", c.first, {0.0, 0.0}, c.second, {0.0, 0.0},
+               {.stiffness = p.stiff, .damping = p.stiff_damping, .free_length = p.spacing}));
   return c;
 }
 

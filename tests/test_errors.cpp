@@ -486,6 +486,75 @@ TEST_CASE("A force far too stiff for the step: the message names the force", "[e
                          odyn::SolverError, SolverErrorAbout("stiff spring", {"converge"}));
 }
 
+TEST_CASE("Assembly reports how far it moved each body; a run warns above a threshold",
+          "[errors]") {
+  // A block welded to the ground at (1, 0, 0) with the global axes, given 2 mm off and turned
+  // 0.01 rad about an oblique axis: assembly must move it by exactly that much. The bob hangs
+  // where its ball joint wants it and stays.
+  Bob bob;
+  sp::Body block = good_body("block", {1.0, 0.002, 0.0});
+  const double turn = 0.01;
+  block.orientation = Eigen::AngleAxisd(turn, Vector3d(1.0, 2.0, 2.0).normalized());
+  const BodyId id = bob.model.add_body(block);
+  const sp::JointFrame global_axes{
+      .point = Vector3d::Zero(), .axis = Vector3d::UnitZ(), .reference = Vector3d::UnitX()};
+  bob.model.add(sp::Fixed(
+      "weld", odyn::ground,
+      {.point = {1.0, 0.0, 0.0}, .axis = Vector3d::UnitZ(), .reference = Vector3d::UnitX()}, id,
+      global_axes));
+  Workspace ws(bob.model);
+  const odyn::AssemblyReport report = odyn::assemble(bob.model, ws);
+  REQUIRE(report.moved_bodies.size() == 1);
+  CHECK(report.moved_bodies[0].body == "block");
+  CHECK(report.moved_bodies[0].translation == Approx(0.002).epsilon(1e-9));
+  CHECK(report.moved_bodies[0].rotation == Approx(turn).epsilon(1e-9));
+
+  odyn::DynamicsSettings settings = short_run();
+  settings.t_end = 0.01;
+  Workspace run(bob.model);
+  const odyn::RunSummary warned = odyn::simulate_with<odyn::GeneralizedAlpha>(
+      bob.model, run, settings, [](const Workspace&) {});
+  REQUIRE(warned.warnings.size() == 1);
+  CHECK(warned.warnings[0].kind == "assembly");
+  CHECK_THAT(warned.warnings[0].text, Catch::Contains("'block' by 0.002 m and 0.01 rad") &&
+                                          Catch::Contains("1 body") && !Catch::Contains("'bob'"));
+  // A rough pose on purpose: thresholds above the move, no warning.
+  settings.assembly.warn_translation = 0.003;
+  settings.assembly.warn_rotation = 0.02;
+  Workspace quiet(bob.model);
+  CHECK(
+      odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, quiet, settings, [](const Workspace&) {
+      }).warnings.empty());
+}
+
+TEST_CASE("A tolerance below what double precision delivers is raised, with a warning",
+          "[errors]") {
+  Bob bob;
+  odyn::DynamicsSettings settings = short_run();
+  settings.t_end = 0.02;
+  settings.generalized_alpha.adaptive = true;
+  auto run = [&](double rtol) {
+    settings.rtol = rtol;
+    Workspace ws(bob.model);
+    ws.v[0] = 1.0;  // swinging about the ball joint at 1 m/s
+    return odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                       [](const Workspace&) {});
+  };
+  const odyn::RunSummary raised = run(1e-16);
+  REQUIRE(raised.warnings.size() == 1);
+  CHECK(raised.warnings[0].kind == "tolerance");
+  CHECK_THAT(raised.warnings[0].text,
+             Catch::Contains("rtol 1e-16") && Catch::Contains(odyn::to_text(odyn::rtol_floor)));
+  // The run is the one at the floor, step for step.
+  const odyn::RunSummary at_floor = run(odyn::rtol_floor);
+  CHECK(at_floor.warnings.empty());
+  CHECK(raised.statistics.steps == at_floor.statistics.steps);
+  CHECK(raised.statistics.steps > 10);
+  // A fixed-step run does not use rtol: nothing to say.
+  settings.generalized_alpha.adaptive = false;
+  CHECK(run(1e-16).warnings.empty());
+}
+
 TEST_CASE("Run settings", "[errors]") {
   Bob bob;
   Workspace ws(bob.model);

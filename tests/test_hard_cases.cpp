@@ -14,14 +14,18 @@
 //  - an undamped double pendulum over 1000 s: energy and constraint drift.
 // The models are in examples/*_model.hpp, so that the benchmarks can reuse them.
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <odyn/odyn.hpp>
@@ -264,22 +268,18 @@ struct ChainRun {
   long singular_steps = 0, steps = 0;
 };
 
-/// Runs the chain with integrator `Integrator` (GeneralizedAlpha or JointGeneralizedAlpha),
-/// "generalized-alpha" or "hht", at a fixed step, and compares it with the reference.
-template <template <class> class Integrator, class Chain>
-ChainRun run_chain(const Chain& chain, const pc::Parameters& p, const std::string& integrator,
-                   double step, double t_end) {
+/// Runs the chain with `simulate(model, ws, settings, observer)` and compares it with the
+/// reference; also returns the run's summary.
+template <class Chain, class Simulate>
+ChainRun observe_chain(const Chain& chain, const pc::Parameters& p,
+                       const odyn::DynamicsSettings& settings, Simulate&& simulate,
+                       odyn::RunSummary* summary_out = nullptr) {
   using Model = std::remove_cvref_t<decltype(chain.model)>;
   odyn::Workspace<Model> ws(chain.model);
-  odyn::DynamicsSettings settings;
-  settings.integrator = integrator;
-  settings.step = step;
-  settings.t_end = t_end;
-  settings.output_interval = 4e-3;  // a multiple of every step here
   PendulumReference reference(p);
   ChainRun run;
-  const auto summary =
-      odyn::simulate_with<Integrator>(chain.model, ws, settings, [&](const auto& w) {
+  const odyn::RunSummary summary =
+      simulate(chain.model, ws, settings, [&](const auto& w) {
         const double first = angle_about_z(w, chain.cranks[0]);
         run.error =
             std::max(run.error, std::abs(std::remainder(first - reference.at(w.t), 2 * pi)));
@@ -293,7 +293,23 @@ ChainRun run_chain(const Chain& chain, const pc::Parameters& p, const std::strin
   run.crossings = reference.crossings;
   run.singular_steps = summary.statistics.singular_steps;
   run.steps = summary.statistics.steps;
+  if (summary_out != nullptr) *summary_out = summary;
   return run;
+}
+
+/// Runs the chain with integrator `Integrator` (GeneralizedAlpha or JointGeneralizedAlpha),
+/// "generalized-alpha" or "hht", at a fixed step, and compares it with the reference.
+template <template <class> class Integrator, class Chain>
+ChainRun run_chain(const Chain& chain, const pc::Parameters& p, const std::string& integrator,
+                   double step, double t_end) {
+  odyn::DynamicsSettings settings;
+  settings.integrator = integrator;
+  settings.step = step;
+  settings.t_end = t_end;
+  settings.output_interval = 4e-3;  // a multiple of every step here
+  return observe_chain(chain, p, settings, [](auto&&... args) {
+    return odyn::simulate_with<Integrator>(std::forward<decltype(args)>(args)...);
+  });
 }
 
 /// The chain's error bound at step h: second order (3e-5 rad at 1e-4 s, about twice the largest
@@ -406,6 +422,37 @@ TEST_CASE("At a singular configuration, bdf and dop853 say so, and their advice 
   // The advice: generalized-alpha (its default step) through the same second.
   check_chain(run_chain<odyn::GeneralizedAlpha>(chain, p, "generalized-alpha", 1e-4, 1.0), 1e-4,
               "the advice followed", 4);
+}
+
+TEST_CASE("Integrator auto passes the chain: dop853 where it can, generalized-alpha where not",
+          "[hard][singular][auto]") {
+  // At rtol 1e-6 dop853's steps pass the crossings; at 1e-10 its steps collapse at the first
+  // one, and auto runs generalized-alpha (h = settings.step) from the start, handing over the
+  // outputs from there: the run passes, at generalized-alpha's accuracy.
+  pc::Parameters p;
+  const auto chain = pc::planar::build<odyn::planar::DefaultModel>(p);
+  odyn::DynamicsSettings settings;
+  settings.integrator = "auto";
+  settings.t_end = chain_t_end;
+  settings.output_interval = 4e-3;
+  const auto run_auto = [](auto&&... args) {
+    return odyn::simulate_auto<odyn::DormandPrince853, odyn::Bdf, odyn::GeneralizedAlpha>(
+        std::forward<decltype(args)>(args)...);
+  };
+  odyn::RunSummary summary;
+  settings.rtol = settings.atol = 1e-6;
+  const ChainRun loose = observe_chain(chain, p, settings, run_auto, &summary);
+  INFO(summary.integrator_choice);
+  CHECK(summary.integrator == "dop853");
+  check_chain(loose, 0.0, "auto at rtol 1e-6");  // measured 1.2e-6 rad
+  settings.rtol = settings.atol = 1e-10;
+  const ChainRun tight = observe_chain(chain, p, settings, run_auto, &summary);
+  INFO(summary.integrator_choice);
+  CHECK_THAT(summary.integrator, Catch::StartsWith("dop853, then generalized-alpha (h = 0.0001 s) "
+                                                   "from the start, its outputs from t = "));
+  CHECK_THAT(summary.integrator_choice,
+             Catch::Contains("nearly loses rank") && Catch::Contains("Generalized-alpha ran"));
+  check_chain(tight, settings.step, "auto at rtol 1e-10");  // measured 1.7e-5 rad
 }
 
 TEST_CASE("A rocker driven through a full turn locks at its dead point: a clear error",
@@ -651,6 +698,71 @@ TEST_CASE("Stiff chain: stable far beyond the explicit limit, fast mode damped b
     // 5.9e-3 rad over 2 s, 8.3e-4 m on 0.14 m.
     CHECK(slow_error.value < 1.2e-3);
   }
+}
+
+namespace {
+
+/// The stiff chain's block displacements from rest, u(t), from the eigen-decomposition of the
+/// linear system m u'' = -K u - C u' (z = (u, u') and z' = A z, z(t) = V exp(Lambda t) V^-1 z0).
+Eigen::Vector2d stiff_chain_displacements(const stiff_chain::Parameters& p, double t) {
+  const double k1 = p.soft, k2 = p.stiff, c = p.stiff_damping, m = p.mass;
+  Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+  a.topRightCorner<2, 2>().setIdentity();
+  a.bottomLeftCorner<2, 2>() << -(k1 + k2) / m, k2 / m, k2 / m, -k2 / m;
+  a.bottomRightCorner<2, 2>() << -c / m, c / m, c / m, -c / m;
+  const Eigen::EigenSolver<Eigen::Matrix4d> eigen(a);
+  const Eigen::Vector4cd z0 =
+      Eigen::Vector4d(p.displacement1, p.displacement2, p.velocity1, p.velocity2)
+          .cast<std::complex<double>>();
+  const Eigen::Vector4cd modal = eigen.eigenvectors().partialPivLu().solve(z0);
+  Eigen::Vector4cd grown;
+  for (int i = 0; i < 4; ++i) grown[i] = std::exp(eigen.eigenvalues()[i] * t) * modal[i];
+  const Eigen::Vector4cd z = eigen.eigenvectors() * grown;
+  return {z[0].real(), z[1].real()};
+}
+
+}  // namespace
+
+TEST_CASE("Integrator auto on a stiff chain: bdf when it pays, dop853 when it does not",
+          "[hard][stiff][auto]") {
+  // Damped (c = 1e6 N s/m beside the 1e8 N/m spring: a fast eigenvalue near -2e6 1/s), dop853
+  // is held by stability (measured 312 798 steps for 1 s); auto's stiffness test hands over to
+  // bdf within its first steps. Undamped, the fast oscillation is there to resolve and bdf's
+  // steps are no longer than dop853's: auto goes back to dop853.
+  const auto run_auto = [](const stiff_chain::Parameters& p, double tolerance,
+                           odyn::RunSummary& summary) {
+    stiff_chain::Chain chain = stiff_chain::build(p);
+    odyn::Workspace<stiff_chain::Model> ws(chain.model);
+    odyn::DynamicsSettings settings;
+    settings.integrator = "auto";
+    settings.rtol = settings.atol = tolerance;
+    settings.t_end = 1.0;
+    settings.output_interval = 1e-2;
+    Largest error;
+    summary = odyn::simulate_auto<odyn::DormandPrince853, odyn::Bdf, odyn::GeneralizedAlpha>(
+        chain.model, ws, settings, [&](const auto& w) {
+          const Eigen::Vector2d u(w.q[0] - p.spacing, w.q[3] - 2.0 * p.spacing);
+          error.add((u - stiff_chain_displacements(p, w.t)).cwiseAbs().maxCoeff());
+        });
+    return error.value;
+  };
+  stiff_chain::Parameters p;
+  p.displacement1 = p.displacement2 = 0.1;
+  p.stiff_damping = 1e6;
+  odyn::RunSummary summary;
+  const double damped = run_auto(p, 1e-8, summary);
+  INFO(summary.integrator_choice << "; error " << damped << " m, " << summary.statistics.steps
+                                 << " steps");
+  CHECK_THAT(summary.integrator, Catch::StartsWith("dop853, then bdf from t = "));
+  CHECK(summary.statistics.steps < 2000);
+  CHECK(damped < 1e-6);
+  p.stiff_damping = 0.0;
+  // (At rtol 1e-8 the accuracy asked for holds dop853's steps below its stability bound.)
+  const double undamped = run_auto(p, 1e-6, summary);
+  INFO(summary.integrator_choice << "; error " << undamped << " m, " << summary.statistics.steps
+                                 << " steps");
+  CHECK_THAT(summary.integrator, Catch::Contains("then bdf") && Catch::Contains("dop853 again"));
+  CHECK(undamped < 1e-5);
 }
 
 // ------------------------------------------------------------------------------------------

@@ -545,6 +545,7 @@ TEST_CASE("A large over-constrained model stays on the sparse path", "[sparse][r
   }
   SECTION("a run against the dense path's run") {
     odyn::DynamicsSettings s;
+    s.integrator = "generalized-alpha";
     s.t_end = 0.05;
     s.step = 1e-3;
     s.output_interval = 0.05;
@@ -727,6 +728,7 @@ TEST_CASE("A long hinged chain, whose pivots shrink as N^-3, assembles and falls
   model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
   odyn::Workspace<HingedModel> ws(model);
   odyn::DynamicsSettings s;
+  s.integrator = "generalized-alpha";
   s.t_end = 0.005;
   s.step = 1e-3;
   s.output_interval = 0.005;

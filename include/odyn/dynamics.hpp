@@ -4,6 +4,7 @@
 // the switches of force laws, and hand the workspace to an observer at t0 and at each output.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -27,14 +28,16 @@ namespace odyn {
 
 struct DynamicsSettings {
   /// s: the step of a fixed-step run (shortened so that steps land on output times), or the
-  /// first step of a run with error control.
+  /// first step of a run with error control; for "auto", also generalized-alpha's step where
+  /// dop853 and bdf fail.
   double step = 1e-4;
   double t_end = 1.0;             // s
   double output_interval = 1e-3;  // s
-  /// By name (see integrator_names()): "generalized-alpha" or "hht" (fixed step, or error
-  /// control when generalized_alpha.adaptive is set), "dopri5", "dop853" and "bdf" (error
-  /// control), "adams" (fixed step, order adams.order).
-  std::string integrator = "generalized-alpha";
+  /// By name (see integrator_names()): "auto" (error control: dop853, bdf when stiff,
+  /// generalized-alpha where both fail; see simulate_auto), "generalized-alpha" or "hht"
+  /// (fixed step, or error control when generalized_alpha.adaptive is set), "dopri5", "dop853"
+  /// and "bdf" (error control), "adams" (fixed step, order adams.order).
+  std::string integrator = "auto";
   /// What the integrator steps: "absolute" (every body's position and orientation, every joint
   /// a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that close
   /// loops as constraints; see analysis/joint_coordinates.hpp), with every integrator.
@@ -54,6 +57,22 @@ struct DynamicsSettings {
   AssemblySettings assembly = {};
 };
 
+/// Something a run did that its user should know although it succeeded.
+struct RunWarning {
+  /// "tolerance": rtol was below what double precision delivers and was raised;
+  /// "assembly": assembly moved bodies beyond the thresholds of AssemblySettings.
+  std::string kind;
+  std::string text;
+};
+
+/// The steps of bdf after which integrator "auto" compares their mean with dop853's (see
+/// simulate_auto).
+inline constexpr long auto_trial_steps = 200;
+
+/// The smallest rtol a run with error control uses (100 machine epsilons, SciPy's floor): a
+/// smaller one only buys more steps whose rounding errors outgrow what they gain.
+inline constexpr double rtol_floor = 100.0 * std::numeric_limits<double>::epsilon();
+
 struct RunSummary {
   IntegratorStatistics statistics;
   AssemblyReport assembly;
@@ -67,6 +86,11 @@ struct RunSummary {
   /// run goes on with the minimum-norm multipliers, and the reactions of these joints are then
   /// one choice among many (see analysis/saddle_point.hpp). Empty for an ordinary mechanism.
   std::vector<RedundantEquation> redundant_equations;
+  std::vector<RunWarning> warnings;
+  /// What integrated: the settings' integrator, or for "auto" the ones it chose ("dop853",
+  /// "dop853, then bdf from t = 0.31 s"), and why (empty unless "auto").
+  std::string integrator;
+  std::string integrator_choice;
 };
 
 /// An assembled initial state kept to start runs from, so that the setup runs once for several
@@ -249,29 +273,40 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
   }
 }
 
-/// Advances an adaptive integrator with dense output (interpolate, restore_trial) from its time
-/// t0 through `outputs` output times t0 + k dt, stepping as its error control proposes: outputs
-/// inside a step are interpolated (so they do not cut the steps), and `record()` sees each one
-/// with the stateful elements advanced to it. Ends exactly at the last output time; events as
-/// in advance_to.
-template <class Model, DenseOutputIntegrator Integrator, class Record>
-void advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integrator& integrator,
-                               double output_interval, long outputs, Record&& record,
+/// The output times of a run, t0 + k dt for k = 1 .. count (t0 itself is recorded before the
+/// first step), and the next one to hand over: a run that changes integrator midway goes on
+/// from there.
+struct OutputGrid {
+  double t0 = 0.0;
+  double interval = 1e-3;
+  long count = 0;
+  long next = 1;
+  double time(long k) const { return t0 + static_cast<double>(k) * interval; }
+  bool done() const { return next > count; }
+};
+
+/// Advances an adaptive integrator with dense output (interpolate, restore_trial) through the
+/// grid's remaining output times, stepping as its error control proposes: outputs inside a step
+/// are interpolated (so they do not cut the steps), and `record()` sees each one with the
+/// stateful elements advanced to it. Ends exactly at the last output time; events as in
+/// advance_to. `stop()`, asked after every accepted step, ends the run there early (the
+/// workspace then holds the committed state): false if it did.
+template <class Model, DenseOutputIntegrator Integrator, class Record, class Stop>
+bool advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integrator& integrator,
+                               OutputGrid& grid, Record&& record, Stop&& stop,
                                double event_time_tolerance = 1e-12) {
-  const double t0 = integrator.time();
-  const auto output_time = [&](long k) { return t0 + static_cast<double>(k) * output_interval; };
-  const double t_end = output_time(outputs);
+  const double t_end = grid.time(grid.count);
   const double time_tolerance = 1e-12 * std::max(1.0, std::abs(t_end));
   auto saved_states = ws.states;  // sized once: the copies below allocate nothing
-  long k = 1;
+  long& k = grid.next;
   // Hands over every output time up to the trial state now in the workspace, then puts the
   // trial state back for its commit.
   const auto emit = [&] {
     const double trial_end = ws.t;
     bool interpolated = false;
-    for (; k <= outputs && output_time(k) <= trial_end + time_tolerance; ++k) {
-      if (output_time(k) < trial_end - time_tolerance) {
-        if (!integrator.interpolate(output_time(k))) integrator.fail();
+    for (; k <= grid.count && grid.time(k) <= trial_end + time_tolerance; ++k) {
+      if (grid.time(k) < trial_end - time_tolerance) {
+        if (!integrator.interpolate(grid.time(k))) integrator.fail();
         interpolated = true;
       } else if (interpolated) {  // the output is the trial state itself
         integrator.restore_trial();
@@ -284,7 +319,7 @@ void advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
     }
     if (interpolated) integrator.restore_trial();
   };
-  while (k <= outputs) {
+  while (k <= grid.count) {
     const double remaining = t_end - integrator.time();
     double h = std::min(integrator.proposed_step(), remaining);
     if (h < remaining && h > 0.5 * remaining) h = 0.5 * remaining;  // no sliver before the end
@@ -304,7 +339,9 @@ void advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
     }
     emit();
     integrator.accept();
+    if (k <= grid.count && stop()) return false;
   }
+  return true;
 }
 
 namespace detail {
@@ -328,9 +365,10 @@ Settings integrator_settings(const DynamicsSettings& s) {
   return settings;
 }
 
+/// The step control of the settings, rtol raised to rtol_floor.
 inline StepControl step_control(const DynamicsSettings& s) {
   return StepControl{
-      .rtol = s.rtol,
+      .rtol = std::max(s.rtol, rtol_floor),
       .atol = s.atol,
       .first_step = s.step,
       .max_step = s.max_step > 0.0 ? s.max_step : std::numeric_limits<double>::infinity()};
@@ -340,6 +378,9 @@ inline StepControl step_control(const DynamicsSettings& s) {
 /// The integrators that `simulate` knows by name, with what they are.
 inline const std::vector<std::pair<std::string, std::string>>& integrator_names() {
   static const std::vector<std::pair<std::string, std::string>> names = {
+      {"auto",
+       "dop853 while not stiff, then bdf (stiffness detected) or generalized-alpha (dop853 "
+       "failed, at a singular configuration say), rtol/atol"},
       {"generalized-alpha",
        "index-3 generalized-alpha (Chung-Hulbert), fixed step h or, with adaptive, rtol/atol"},
       {"hht", "index-3 HHT-alpha, fixed step h or, with adaptive, rtol/atol"},
@@ -351,13 +392,13 @@ inline const std::vector<std::pair<std::string, std::string>>& integrator_names(
   return names;
 }
 
-/// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
-/// instantiated), from the workspace's state (assembled first, or taken from `start`, see
-/// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
-/// and element blocks up to date.
-template <template <class> class IntegratorType, class Model, class Observer>
-RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
+namespace detail {
+
+/// The start of every run: the settings checked, the workspace assembled (or the kept start
+/// taken, see AssembledStart), and what the assembly did that deserves a warning.
+template <class Model>
+RunSummary start_run(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                     AssembledStart<Model>* start) {
   if (!(s.step > 0.0) || !(s.output_interval > 0.0) || !(s.t_end >= ws.t))
     throw ModelError("dynamics",
                      "step and output interval must be positive and t_end >= t0 "
@@ -367,9 +408,6 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   if (!(s.rtol > 0.0) || !(s.atol > 0.0))
     throw ModelError("dynamics", "rtol and atol must be positive (got rtol " + to_text(s.rtol) +
                                      ", atol " + to_text(s.atol) + ")");
-  using Integrator = IntegratorType<Model>;
-  static_assert(StepIntegrator<Integrator>);
-  const auto started = std::chrono::steady_clock::now();
   RunSummary summary;
   AssemblySettings assembly = s.assembly;
   assembly.linear_solver = s.linear_solver;
@@ -389,33 +427,219 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
     summary.redundant_equations = redundant_equations(model, ws);
     if (start != nullptr) start->keep(ws, summary.assembly, summary.redundant_equations, assembly);
   }
-  Integrator integrator(model, ws, detail::integrator_settings<typename Integrator::Settings>(s),
-                        detail::step_control(s));
-  summary.setup_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (const std::string moved = assembly_motion_warning(summary.assembly, assembly); !moved.empty())
+    summary.warnings.push_back({"assembly", moved});
+  return summary;
+}
 
-  auto record = [&] {
+/// The warning for an rtol below rtol_floor (which step_control raised), if the integrator
+/// controls its error.
+inline void note_tolerance_floor(const DynamicsSettings& s, bool adaptive, RunSummary& summary) {
+  if (s.rtol < rtol_floor && adaptive)
+    summary.warnings.push_back(
+        {"tolerance", "rtol " + to_text(s.rtol) +
+                          " is below what double precision can deliver; the run used " +
+                          to_text(rtol_floor) +
+                          " (100 machine epsilons): a smaller one only adds steps and rounding"});
+}
+
+inline OutputGrid output_grid(const DynamicsSettings& s, double t0) {
+  return {.t0 = t0,
+          .interval = s.output_interval,
+          .count = static_cast<long>(std::floor((s.t_end - t0) / s.output_interval + 1e-9))};
+}
+
+/// Hands the workspace to the observer at an output, with the blocks of every element up to
+/// date, and keeps the largest constraint residuals.
+template <class Model, class Observer>
+struct OutputRecorder {
+  const Model& model;
+  Workspace<Model>& ws;
+  Observer& observe;
+  RunSummary& summary;
+
+  template <class Integrator>
+  void operator()(Integrator& integrator) {
     if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
     const auto [phi_norm, phid_norm] = constraint_residuals(model, ws);
     summary.max_position_residual = std::max(summary.max_position_residual, phi_norm);
     summary.max_velocity_residual = std::max(summary.max_velocity_residual, phid_norm);
     ++summary.outputs;
     observe(std::as_const(ws));
-  };
-  record();
-  const double t0 = ws.t;
-  const long outputs = static_cast<long>(std::floor((s.t_end - t0) / s.output_interval + 1e-9));
-  bool dense = false;
-  if constexpr (DenseOutputIntegrator<Integrator>) dense = integrator.adaptive();
+  }
+};
+
+/// Runs an integrator from the workspace's state through the grid's remaining outputs, or, if
+/// it interpolates its outputs, until stop() after an accepted step: false if it stopped.
+template <class Model, class Integrator, class Recorder, class Stop>
+bool run_integrator(const Model& model, Workspace<Model>& ws, Integrator& integrator,
+                    const DynamicsSettings& s, OutputGrid& grid, Recorder& recorder, Stop&& stop) {
+  const auto record = [&] { recorder(integrator); };
   if constexpr (DenseOutputIntegrator<Integrator>)
-    if (dense) advance_with_dense_output(model, ws, integrator, s.output_interval, outputs, record);
+    if (integrator.adaptive())
+      return advance_with_dense_output(model, ws, integrator, grid, record, stop);
   StepCut cut;
-  for (long k = 1; k <= outputs && !dense; ++k) {
-    advance_to(model, ws, integrator, t0 + static_cast<double>(k) * s.output_interval, s.step,
-               1e-12, &cut);
+  for (; !grid.done(); ++grid.next) {
+    advance_to(model, ws, integrator, grid.time(grid.next), s.step, 1e-12, &cut);
     record();
   }
+  return true;
+}
+
+/// Adds the counters of a later part of a run.
+inline void add_statistics(IntegratorStatistics& total, const IntegratorStatistics& part) {
+  total.steps += part.steps;
+  total.newton_iterations += part.newton_iterations;
+  total.jacobian_evaluations += part.jacobian_evaluations;
+  total.factorizations += part.factorizations;
+  total.residual_evaluations += part.residual_evaluations;
+  total.rejected_steps += part.rejected_steps;
+  total.restarts += part.restarts;
+  total.events += part.events;
+  total.singular_steps += part.singular_steps;
+  total.max_error_estimate = std::max(total.max_error_estimate, part.max_error_estimate);
+}
+
+}  // namespace detail
+
+/// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
+/// instantiated), from the workspace's state (assembled first, or taken from `start`, see
+/// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
+/// and element blocks up to date.
+template <template <class> class IntegratorType, class Model, class Observer>
+RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
+  using Integrator = IntegratorType<Model>;
+  static_assert(StepIntegrator<Integrator>);
+  const auto started = std::chrono::steady_clock::now();
+  RunSummary summary = detail::start_run(model, ws, s, start);
+  Integrator integrator(model, ws, detail::integrator_settings<typename Integrator::Settings>(s),
+                        detail::step_control(s));
+  detail::note_tolerance_floor(s, integrator.adaptive(), summary);
+  summary.integrator = integrator.name();
+  summary.setup_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
+  recorder(integrator);
+  OutputGrid grid = detail::output_grid(s, ws.t);
+  detail::run_integrator(model, ws, integrator, s, grid, recorder, [] { return false; });
   summary.statistics = integrator.statistics();
+  summary.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return summary;
+}
+
+/// The integrator "auto": dop853 with error control (rtol, atol) while it does well; from a
+/// step where its stiffness test fires (the step held by stability, not accuracy, for 15
+/// steps), bdf with the same tolerances, unless its first auto_trial_steps steps are shorter
+/// on average than dop853's were (an undamped stiff oscillation, which bdf resolves rather
+/// than damps): then dop853 again to the end. If either fails (at a singular configuration, say,
+/// where the accelerations of dop853 and bdf's iteration break down), generalized-alpha at the
+/// fixed step settings.step, which steps through such configurations, runs again from the
+/// start and hands over the outputs from where the failed method stopped: the outputs after
+/// that are a generalized-alpha run's. The summary's `integrator` says what ran,
+/// `integrator_choice` why. `Explicit`, `Stiff` and `Robust` are the three in the run's
+/// coordinates.
+template <template <class> class Explicit, template <class> class Stiff,
+          template <class> class Robust, class Model, class Observer>
+RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
+  const auto started = std::chrono::steady_clock::now();
+  RunSummary summary = detail::start_run(model, ws, s, start);
+  const Workspace<Model> assembled = ws;  // for the robust run, if it comes to that
+  const StepControl control = detail::step_control(s);
+  std::optional<Explicit<Model>> explicit_method;
+  explicit_method.emplace(model, ws, detail::integrator_settings<DormandPrinceSettings>(s),
+                          control);
+  detail::note_tolerance_floor(s, true, summary);
+  summary.setup_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
+  recorder(*explicit_method);
+  OutputGrid grid = detail::output_grid(s, ws.t);
+  summary.integrator = "dop853";
+  summary.integrator_choice = "auto: dop853 throughout (not stiff, no failure)";
+  std::string failure;
+  double failed_at = 0.0;
+  try {
+    const bool finished =
+        detail::run_integrator(model, ws, *explicit_method, s, grid, recorder,
+                               [&] { return explicit_method->stiffness_detected(); });
+    if (!finished) {
+      const double stiff_from = explicit_method->time();
+      summary.integrator = "dop853, then bdf from t = " + to_text(stiff_from) + " s";
+      summary.integrator_choice = "auto: stiff at t = " + to_text(stiff_from) + " s (h |lambda| " +
+                                  to_text(explicit_method->stiffness_estimate()) +
+                                  " beyond dop853's stability bound for 15 steps): bdf from there";
+      // dop853's mean step, against which bdf's must pay off: an undamped stiff oscillation
+      // holds bdf's steps as short (it resolves the oscillation rather than damping it).
+      const double explicit_mean_step =
+          (stiff_from - grid.t0) /
+          static_cast<double>(std::max(1L, explicit_method->statistics().steps));
+      detail::add_statistics(summary.statistics, explicit_method->statistics());
+      explicit_method.reset();
+      std::optional<Stiff<Model>> stiff;
+      bool paid_off = true;
+      try {
+        stiff.emplace(model, ws, detail::integrator_settings<BdfSettings>(s), control);
+        paid_off = detail::run_integrator(model, ws, *stiff, s, grid, recorder, [&] {
+          const long steps = stiff->statistics().steps;
+          return steps == auto_trial_steps &&
+                 (stiff->time() - stiff_from) / static_cast<double>(steps) < explicit_mean_step;
+        });
+      } catch (const SolverError& error) {
+        failure = error.message();
+        failed_at = error.time();
+      }
+      if (stiff) detail::add_statistics(summary.statistics, stiff->statistics());
+      if (!paid_off) {  // back to dop853, held by stability, to the end
+        const double back_at = stiff->time();
+        stiff.reset();
+        summary.integrator += ", dop853 again from t = " + to_text(back_at) + " s";
+        summary.integrator_choice += "; bdf's first " + std::to_string(auto_trial_steps) +
+                                     " steps were shorter than dop853's on average: dop853 "
+                                     "again";
+        explicit_method.emplace(model, ws, detail::integrator_settings<DormandPrinceSettings>(s),
+                                control);
+        detail::run_integrator(model, ws, *explicit_method, s, grid, recorder,
+                               [] { return false; });
+      }
+    }
+  } catch (const SolverError& error) {
+    failure = error.message();
+    failed_at = error.time();
+  }
+  if (explicit_method) detail::add_statistics(summary.statistics, explicit_method->statistics());
+  explicit_method.reset();
+  if (!failure.empty()) {
+    // Generalized-alpha from the start, silent up to the outputs already handed over.
+    const std::string failed =
+        "at t = " + to_text(failed_at) + " s: " + failure + " Generalized-alpha ran instead";
+    summary.integrator_choice = summary.integrator == "dop853"
+                                    ? "auto: dop853 failed " + failed
+                                    : summary.integrator_choice + "; " + failed;
+    summary.integrator +=
+        ", then generalized-alpha (h = " + to_text(s.step) +
+        " s) from the start, its outputs from t = " + to_text(grid.time(grid.next)) + " s";
+    DynamicsSettings robust_settings = s;
+    robust_settings.integrator = "generalized-alpha";
+    robust_settings.generalized_alpha.adaptive = false;
+    ws = assembled;
+    Robust<Model> robust(
+        model, ws, detail::integrator_settings<GeneralizedAlphaSettings>(robust_settings), control);
+    try {
+      StepCut cut;
+      for (long k = 1; k < grid.next; ++k)
+        advance_to(model, ws, robust, grid.time(k), s.step, 1e-12, &cut);
+      for (; !grid.done(); ++grid.next) {
+        advance_to(model, ws, robust, grid.time(grid.next), s.step, 1e-12, &cut);
+        recorder(robust);
+      }
+    } catch (const SolverError& error) {
+      throw SolverError(error.time(), error.message() + " (" + summary.integrator_choice + ")");
+    }
+    detail::add_statistics(summary.statistics, robust.statistics());
+  }
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
@@ -427,6 +651,9 @@ template <class Model, class Observer>
 RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
                     Observer&& observe, AssembledStart<Model>* start = nullptr) {
   if (s.coordinates == "joint") {
+    if (s.integrator == "auto")
+      return simulate_auto<JointDormandPrince853, JointBdf, JointGeneralizedAlpha>(model, ws, s,
+                                                                                   observe, start);
     if (s.integrator == "dopri5")
       return simulate_with<JointDormandPrince>(model, ws, s, observe, start);
     if (s.integrator == "dop853")
@@ -437,14 +664,16 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
       return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
     if (s.integrator == "bdf") return simulate_with<JointBdf>(model, ws, s, observe, start);
     throw ModelError("dynamics",
-                     "joint coordinates run with generalized-alpha, hht, bdf, dopri5, dop853 or "
-                     "adams, not '" +
+                     "joint coordinates run with auto, generalized-alpha, hht, bdf, dopri5, "
+                     "dop853 or adams, not '" +
                          s.integrator +
                          "'; choose one of those, or coordinates 'absolute' for this integrator");
   } else if (s.coordinates != "absolute") {
     throw ModelError("dynamics",
                      "unknown coordinates '" + s.coordinates + "'; choose 'absolute' or 'joint'");
   }
+  if (s.integrator == "auto")
+    return simulate_auto<DormandPrince853, Bdf, GeneralizedAlpha>(model, ws, s, observe, start);
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
     return simulate_with<GeneralizedAlpha>(model, ws, s, observe, start);
   if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe, start);

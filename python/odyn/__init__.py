@@ -29,9 +29,9 @@ from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
-from .results import (BodyHistory, Interrupted, PlanarBodyHistory, Reaction,
-                      RedundantConstraintsWarning, Result, Statistics, assemble, integrators,
-                      simulate)
+from .results import (AssemblyWarning, BodyHistory, Interrupted, PlanarBodyHistory, Reaction,
+                      RedundantConstraintsWarning, Result, Statistics, ToleranceWarning,
+                      assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
 
 #: Every element type that Model.add accepts (and scenes, except user_force).
@@ -43,9 +43,10 @@ planar_element_types = tuple(
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "BaseModel", "BodyHistory", "Error", "Interrupted", "Model", "ModelError",
-    "PlanarBodyHistory", "PlanarModel", "Reaction", "RedundantConstraintsWarning", "Result",
-    "Scene", "SceneError", "SolverError", "Statistics", "assemble", "constant_velocity",
-    "element_types", "frame", "harmonic", "integrators", "load", "loads", "motion_function",
-    "planar_element_types", "polynomial", "save", "simulate",
+    "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Interrupted",
+    "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "Reaction",
+    "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
+    "ToleranceWarning", "assemble", "constant_velocity", "element_types", "frame", "harmonic",
+    "integrators", "load", "loads", "motion_function", "planar_element_types", "polynomial",
+    "save", "simulate",
 ]

@@ -7,6 +7,7 @@ import argparse
 import os
 import sys
 import time
+import warnings
 from typing import List, NoReturn, Optional, Tuple
 
 import numpy as np
@@ -112,6 +113,8 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
     m = scene.model
     lines.append(f"  {m.space} model: {m.num_velocities} coordinates, {m.num_equations} "
                  "constraint equations")
+    if s and s.get("integrator_choice"):
+        lines.append(f"  {s['integrator_choice']}")
     if s:
         steps = s["steps"]
         lines.append(f"  steps {steps} (events {s['events']}, rejected {s['rejected_steps']}), "
@@ -221,8 +224,15 @@ def _integrators() -> int:
     return 0
 
 
+def _format_warning(message, category, filename, lineno, line=None) -> str:
+    """A warning as one line, "odyn: warning: ...": the source line of the library that issued
+    it means nothing to the user of a scene."""
+    return f"odyn: warning: {message}\n"
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     args = _parser().parse_args(argv)
+    formatter, warnings.formatwarning = warnings.formatwarning, _format_warning
     try:
         if args.command == "integrators":
             return _integrators()
@@ -233,6 +243,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     except KeyboardInterrupt:  # outside a run (which keeps its outputs): nothing to keep
         print("odyn: interrupted", file=sys.stderr)
         return 130
+    finally:
+        warnings.formatwarning = formatter
 
 
 if __name__ == "__main__":

@@ -31,6 +31,21 @@ class RedundantConstraintsWarning(UserWarning):
     the reactions of the joints named are one choice among many."""
 
 
+class AssemblyWarning(UserWarning):
+    """Assembly moved bodies farther from the poses they were given than its thresholds (1e-5 m
+    or 1e-5 rad): the given poses do not meet the constraints, often because a joint's points
+    or axes do not fit the bodies. `Result.assembly["moved_bodies"]` lists how far each moved."""
+
+
+class ToleranceWarning(UserWarning):
+    """rtol was below what double precision can deliver (100 machine epsilons, 2.2e-14) and
+    the run used that floor instead."""
+
+
+#: The warning class of each kind of warning a run reports.
+_WARNING_CLASSES = {"assembly": AssemblyWarning, "tolerance": ToleranceWarning}
+
+
 class Interrupted(KeyboardInterrupt):
     """A run stopped by Ctrl-C (SIGINT). `result` holds the outputs computed before it."""
 
@@ -124,6 +139,16 @@ class Result:
         "equation" (its index among the joint's equations), "row" (of Phi)}; empty for an
         ordinary mechanism. Their joints' reactions are the minimum-norm choice."""
         return list((self.assembly or {}).get("redundant_equations", []))
+
+    @property
+    def warnings(self) -> List[str]:
+        """What the analysis warned about although it succeeded (a tolerance raised to its
+        floor, bodies that assembly moved far), as texts; each was also issued as a Python
+        warning (`AssemblyWarning`, `ToleranceWarning`)."""
+        return [w["text"] for w in self._warnings()]
+
+    def _warnings(self) -> List[Dict[str, str]]:
+        return list(self._data.get("warnings") or (self.summary or {}).get("warnings", []))
 
     def __getitem__(self, key: str) -> np.ndarray:
         """result["lambda"] and the other arrays by name."""
@@ -250,7 +275,11 @@ def _check_order(order: Optional[int]) -> Optional[int]:
     return order
 
 
-def _warn_redundant(result: Result) -> None:
+def _warn(result: Result) -> None:
+    """Issues the result's warnings as Python warnings, where the user's code called."""
+    for warning in result._warnings():
+        warnings.warn(_WARNING_CLASSES.get(warning["kind"], UserWarning)(warning["text"]),
+                      stacklevel=3)
     equations = result.redundant_equations
     if equations:
         named = ", ".join(f"{e['joint']} (equation {e['equation']})" for e in equations)
@@ -277,12 +306,12 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
     result = Result(data)
-    _warn_redundant(result)
+    _warn(result)
     return result
 
 
-def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
-             output_interval: float = 1e-3, integrator: str = "generalized-alpha",
+def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = None,
+             output_interval: float = 1e-3, integrator: Optional[str] = None,
              rho_inf: float = 0.9, rtol: Optional[float] = None, atol: Optional[float] = None,
              max_step: Optional[float] = None, adaptive: Optional[bool] = None,
              progress: Optional[Callable[[float], None]] = None,
@@ -300,7 +329,12 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     changed); `summary["assembly"]["reused"]` says which happened, and `setup_seconds` then
     counts the integrator's setup only.
 
-    integrator: a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
+    integrator: by default "auto", or "generalized-alpha" when `step` is given without rtol
+    or atol (a fixed step) or when `adaptive` is given. "auto" controls the error to rtol and atol (default 1e-6): dop853
+    while it does well, bdf from where the problem turns stiff (if bdf's steps are longer),
+    and generalized-alpha at `step` (default 1e-4 s) from the start if either fails, at a
+    singular configuration say; `summary["integrator"]` says what ran and
+    `summary["integrator_choice"]` why. Or a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
     rho_inf) or "hht" take fixed steps of at most `step` (a step whose Newton iteration fails
     is tried again in halves, down to step / 16, and grows back after a few good steps), or,
     with error control (`adaptive`;
@@ -336,6 +370,11 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     as its `result` attribute. A consistently over-constrained mechanism runs with minimum-norm
     multipliers and a `RedundantConstraintsWarning` (see `Result.redundant_equations`).
     """
+    if integrator is None:  # `adaptive` is generalized-alpha's option
+        fixed_step = step is not None and rtol is None and atol is None
+        integrator = "generalized-alpha" if fixed_step or adaptive is not None else "auto"
+    if step is None:
+        step = 1e-4
     settings = _settings(step, t_end, output_interval, integrator, rho_inf, rtol, atol,
                          max_step, adaptive, newton_rtol=newton_rtol, newton_atol=newton_atol,
                          constraint_tolerance=constraint_tolerance,
@@ -350,7 +389,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: float = 1e-4,
     error = data.pop("error")
     if error is None:
         result = Result(data)
-        _warn_redundant(result)
+        _warn(result)
         return result
     result = Result(data, interrupted=True)
     if isinstance(error, KeyboardInterrupt):

@@ -212,7 +212,28 @@ inline py::dict assembly_report(const AssemblyReport& r) {
   d["velocity_residual"] = r.velocity_residual;
   d["kept_velocity_components"] = r.kept_velocity_components;
   d["adjusted_velocity_components"] = r.adjusted_velocity_components;
+  py::list moved;
+  for (const BodyDisplacement& b : r.moved_bodies) {
+    py::dict body;
+    body["body"] = b.body;
+    body["translation"] = b.translation;
+    body["rotation"] = b.rotation;
+    moved.append(body);
+  }
+  d["moved_bodies"] = moved;
   return d;
+}
+
+/// A run's warnings as [{"kind", "text"}] (Python turns each into a warning of its class).
+inline py::list warning_list(const std::vector<RunWarning>& warnings) {
+  py::list out;
+  for (const RunWarning& w : warnings) {
+    py::dict d;
+    d["kind"] = w.kind;
+    d["text"] = w.text;
+    out.append(d);
+  }
+  return out;
 }
 
 /// Constraint equations that repeat others (the run uses minimum-norm multipliers for them).
@@ -246,6 +267,9 @@ inline py::dict run_summary(const RunSummary& s) {
   d["setup_seconds"] = s.setup_seconds;
   d["max_position_residual"] = s.max_position_residual;
   d["max_velocity_residual"] = s.max_velocity_residual;
+  d["warnings"] = warning_list(s.warnings);
+  d["integrator"] = s.integrator;
+  d["integrator_choice"] = s.integrator_choice;
   py::dict assembly = assembly_report(s.assembly);
   assembly["redundant_equations"] = redundant_list(s.redundant_equations);
   assembly["reused"] = s.assembly_reused;
@@ -316,6 +340,10 @@ py::dict assemble(Box& box, const py::dict& settings) {
   py::dict assembly = assembly_report(report);
   assembly["redundant_equations"] = redundant_list(redundant);
   out["assembly"] = assembly;
+  std::vector<RunWarning> warnings;
+  if (std::string moved = assembly_motion_warning(report, s); !moved.empty())
+    warnings.push_back({"assembly", std::move(moved)});
+  out["warnings"] = warning_list(warnings);
   return out;
 }
 

@@ -5,6 +5,7 @@ import json
 import math
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -78,7 +79,7 @@ def test_generalized_alpha_fixed_and_adaptive(exact_angle):
     np.testing.assert_allclose(fixed.body("bob").angle, exact_angle, atol=1e-4)
     # rtol/atol turn on error control (as the C++ examples' --rtol) ...
     adaptive = odyn.simulate(pendulum(), t_end=1.0, step=1e-3, output_interval=0.1,
-                             rtol=1e-5, atol=1e-5)
+                             rtol=1e-5, atol=1e-5, integrator="generalized-alpha")
     assert adaptive.statistics.steps != 1000
     # ... unless adaptive=False: fixed steps, the tolerances only scale the error estimate.
     off = odyn.simulate(pendulum(), t_end=1.0, step=1e-3, output_interval=0.1, rtol=1e-5,
@@ -169,3 +170,56 @@ def test_adams_fixed_steps_and_its_order(exact_angle):
         odyn.simulate(pendulum(), integrator="adams", order=7)
     with pytest.raises(odyn.SceneError, match=r"analysis\.order: expected an integer from 1 to 6"):
         odyn.loads(json.dumps(engine_with({"integrator": "adams", "order": 0})))
+
+
+def test_a_tolerance_below_what_doubles_deliver_is_raised_with_a_warning(exact_angle):
+    with pytest.warns(odyn.ToleranceWarning, match=r"rtol 1e-16 .* 2\.2\d*e-14"):
+        raised = odyn.simulate(pendulum(), t_end=0.1, output_interval=0.1, integrator="dop853",
+                               rtol=1e-16, atol=1e-16)
+    assert len(raised.warnings) == 1 and "100 machine epsilons" in raised.warnings[0]
+    assert abs(raised.body("bob").angle[-1] - exact_angle[1]) < 1e-12
+    # The run is the one at the floor, step for step; that one says nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        floor = odyn.simulate(pendulum(), t_end=0.1, output_interval=0.1, integrator="dop853",
+                              rtol=100 * np.finfo(float).eps, atol=1e-16)
+    assert floor.warnings == []
+    assert raised.statistics.steps == floor.statistics.steps
+    np.testing.assert_array_equal(raised.q, floor.q)
+
+
+def test_assembly_says_how_far_it_moved_a_body_given_off_its_joint(tmp_path):
+    # The engine's rod given 2 mm off along the crank axis (x): its joints put it back, alone.
+    scene = json.loads(ENGINE_SCENE.read_text())
+    rod = next(b for b in scene["bodies"] if b["name"] == "rod")
+    rod["position"] = [0.002, rod["position"][1], rod["position"][2]]
+    path = tmp_path / "moved.json"
+    path.write_text(json.dumps(scene))
+    with pytest.warns(odyn.AssemblyWarning, match=r"'rod' by 0\.002 m"):
+        r = odyn.load(path).simulate(t_end=0.002)
+    moved = {b["body"]: b for b in r.assembly["moved_bodies"]}
+    assert moved["rod"]["translation"] == pytest.approx(0.002, rel=1e-9)
+    assert moved["rod"]["rotation"] < 1e-12 and "crank" not in moved
+    # odyn.assemble says the same; the CLI prints it as one line.
+    with pytest.warns(odyn.AssemblyWarning, match="'rod'"):
+        odyn.assemble(odyn.load(path).model)
+    run = subprocess.run([sys.executable, "-m", "odyn", "run", str(path), "--t-end", "0.002",
+                          "--quiet"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.startswith("odyn: warning: assembly moved 1 body") and "'rod'" in run.stderr
+    # The unchanged scene assembles without a warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        odyn.assemble(odyn.load(ENGINE_SCENE).model)
+
+
+def test_the_default_is_auto_and_a_step_alone_means_generalized_alpha(exact_angle):
+    chosen = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.1)
+    assert chosen.summary["integrator"] == "dop853"
+    assert "not stiff" in chosen.summary["integrator_choice"]
+    # rtol = atol = 1e-6 by default; the pendulum's angle to about that.
+    np.testing.assert_allclose(chosen.body("bob").angle, exact_angle, atol=1e-5)
+    fixed = odyn.simulate(pendulum(), t_end=1.0, step=1e-3, output_interval=0.1)
+    assert fixed.summary["integrator"] == "generalized-alpha"
+    assert fixed.summary["integrator_choice"] == ""
+    assert fixed.statistics.steps == 1000

@@ -32,10 +32,21 @@ struct AssemblySettings {
   /// dense: rank-revealing QR of whole matrices (small models); cholmod or klu: sparse rows and
   /// a sparse LU, linear in the model's size; auto: sparse above dense_assembly_limit unknowns.
   LinearSolver linear_solver = LinearSolver::automatic;
+  /// A run warns when assembly moves a body farther than this from the pose it was given (m, rad):
+  /// a joint whose points or axes do not fit the bodies' poses shows up that way.
+  double warn_translation = 1e-5;
+  double warn_rotation = 1e-5;
 };
 
 /// Velocities plus constraint equations up to which `auto` assembles with dense matrices.
 inline constexpr int dense_assembly_limit = 100;
+
+/// How far assembly moved one body from the pose it was given.
+struct BodyDisplacement {
+  std::string body;
+  double translation = 0.0;  // of its origin, m
+  double rotation = 0.0;     // angle of the rotation between the two orientations, rad
+};
 
 struct AssemblyReport {
   int iterations = 0;
@@ -43,7 +54,37 @@ struct AssemblyReport {
   double velocity_residual = 0.0;                 // max |Phi_q v + Phi_t|
   std::vector<int> kept_velocity_components;      // indices into v the assembly kept
   std::vector<int> adjusted_velocity_components;  // given components it had to change
+  /// The bodies the position stage moved beyond rounding (1e-12 m or rad), in body order.
+  std::vector<BodyDisplacement> moved_bodies;
 };
+
+/// What a run should say about the assembly's moves: empty if no body moved beyond the
+/// settings' thresholds, else the bodies that did (the farthest first) and what to check.
+inline std::string assembly_motion_warning(const AssemblyReport& report,
+                                           const AssemblySettings& s) {
+  std::vector<BodyDisplacement> far;
+  for (const BodyDisplacement& d : report.moved_bodies)
+    if (d.translation > s.warn_translation || d.rotation > s.warn_rotation) far.push_back(d);
+  if (far.empty()) return "";
+  // Farthest first, by the larger of the two in units of its threshold.
+  const auto size = [&s](const BodyDisplacement& d) {
+    return std::max(d.translation / s.warn_translation, d.rotation / s.warn_rotation);
+  };
+  std::stable_sort(far.begin(), far.end(),
+                   [&](const auto& a, const auto& b) { return size(a) > size(b); });
+  constexpr std::size_t shown = 5;
+  std::string list;
+  for (std::size_t i = 0; i < std::min(far.size(), shown); ++i)
+    list += (i == 0 ? "" : ", ") + ("'" + far[i].body + "' by " + to_text(far[i].translation) +
+                                    " m and " + to_text(far[i].rotation) + " rad");
+  if (far.size() > shown) list += " and " + std::to_string(far.size() - shown) + " more";
+  return "assembly moved " + std::to_string(far.size()) + (far.size() == 1 ? " body" : " bodies") +
+         " from the given pose beyond " + to_text(s.warn_translation) + " m or " +
+         to_text(s.warn_rotation) + " rad: " + list +
+         ". The given poses do not meet the constraints there: check the joints' points and "
+         "axes against the bodies' poses (a rough pose on purpose is fine; raise "
+         "warn_translation and warn_rotation of the assembly settings to silence this).";
+}
 
 /// A constraint equation that depends on the others at the current pose.
 struct RedundantEquation {
@@ -319,13 +360,30 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
   return iteration;
 }
 
+namespace detail {
+template <class Model>
+void record_moves(const Model& model, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                  AssemblyReport& report) {
+  constexpr int nq = Model::nq;
+  constexpr double rounding = 1e-12;
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const auto [translation, rotation] = Model::Space::displacement(
+        from.template segment<nq>(b * nq), to.template segment<nq>(b * nq));
+    if (translation > rounding || rotation > rounding)
+      report.moved_bodies.push_back({model.body(BodyId{b + 1}).name, translation, rotation});
+  }
+}
+}  // namespace detail
+
 /// Assembles positions, velocities, accelerations and multipliers at time ws.t.
 template <class Model>
 AssemblyReport assemble(const Model& model, Workspace<Model>& ws, const AssemblySettings& s = {}) {
   constexpr int nv = Model::nv;
   AssemblyReport report;
   const Eigen::VectorXd user_velocity = ws.v;
+  const Eigen::VectorXd given_pose = ws.q;
   report.iterations = assemble_positions(model, ws, s);
+  detail::record_moves(model, given_pose, ws.q, report);
   report.position_residual = model.num_equations() > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
 
   if (detail::sparse_assembly(model, s)) {

@@ -8,6 +8,7 @@
 // is constant with no gyroscopic term.
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 
 namespace odyn {
@@ -117,6 +118,13 @@ struct Planar {
     frame.rotation = rotation(q[2]);
     frame.linear_velocity = v.head<2>();
     frame.angular_velocity[0] = v[2];
+  }
+
+  /// How far a body moved from q_from to q_to: the distance of its origin and the angle it
+  /// turned (rad; whole turns count, as the angle coordinate does).
+  static std::array<double, 2> displacement(const Eigen::Ref<const Configuration>& q_from,
+                                            const Eigen::Ref<const Configuration>& q_to) {
+    return {(q_to.head<2>() - q_from.head<2>()).norm(), std::abs(q_to[2] - q_from[2])};
   }
 
   /// q_out = q_in + increment: the plane's motions commute, so the group is a vector space.

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
+#include <cmath>
 
 #include "odyn/core/rotation.hpp"
 
@@ -117,6 +119,15 @@ struct Spatial {
     frame.rotation = orientation(q).toRotationMatrix();
     frame.linear_velocity = v.head<3>();
     frame.angular_velocity = v.tail<3>();
+  }
+
+  /// How far a body moved from q_from to q_to: the distance of its origin and the angle of the
+  /// rotation between the two orientations (rad, in [0, pi]).
+  static std::array<double, 2> displacement(const Eigen::Ref<const Configuration>& q_from,
+                                            const Eigen::Ref<const Configuration>& q_to) {
+    const Eigen::Quaterniond turn = orientation(q_from).conjugate() * orientation(q_to);
+    return {(q_to.head<3>() - q_from.head<3>()).norm(),
+            2.0 * std::atan2(turn.vec().norm(), std::abs(turn.w()))};
   }
 
   /// q_out = q_in composed with exp(increment): translation in the global frame, rotation

@@ -183,6 +183,8 @@ class Adams {
                           "the order, or take an implicit integrator (generalized-alpha, bdf)");
   }
 
+  /// Its name in integrator_names().
+  static std::string name() { return "adams"; }
   bool adaptive() const { return false; }
   double time() const { return t_n_; }
   /// Local error estimate of the last attempt in units of the tolerances of `control`.

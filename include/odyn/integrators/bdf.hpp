@@ -375,6 +375,8 @@ class BdfMethod {
     throw SolverError(t_failed, message);
   }
 
+  /// Its name in integrator_names().
+  static std::string name() { return "bdf"; }
   bool adaptive() const { return true; }
   double time() const { return t_n_; }
   double proposed_step() const { return proposed_step_; }

@@ -35,6 +35,7 @@ struct DormandPrince853Tableau {
   static constexpr bool last_stage_is_new_point = false;
   static constexpr double min_step_factor = 0.333, max_step_factor = 6.0;  // as in DOP853
   static constexpr double stabilization_exponent = 0.04;                   // as in Hairer's DOPRI5
+  static constexpr double stiffness_bound = 6.1;                           // as in DOP853
 
   static constexpr std::array<double, stages> c = {0.0,
                                                    0.526001519587677318785587544488e-1,

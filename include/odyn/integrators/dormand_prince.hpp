@@ -24,6 +24,7 @@ struct DormandPrince5Tableau {
   static constexpr bool last_stage_is_new_point = true;
   static constexpr double min_step_factor = 0.2, max_step_factor = 5.0;
   static constexpr double stabilization_exponent = 0.04;  // as in Hairer's DOPRI5
+  static constexpr double stiffness_bound = 3.25;         // as in DOPRI5
   static constexpr std::array<double, stages> c = {0.0,     1.0 / 5, 3.0 / 10, 4.0 / 5,
                                                    8.0 / 9, 1.0,     1.0};
   static constexpr std::array<std::array<double, stages>, stages> a = {{

@@ -55,6 +55,8 @@ struct DormandPrinceSettings {
 ///   error_weights[s]: h sum e_i k_i estimates the local error, of order error_order + 1 in h;
 ///   min_step_factor, max_step_factor: bounds of the step-size change;
 ///   stabilization_exponent: beta of the PI step control (0: plain I control);
+///   stiffness_bound: h |lambda| beyond which stability, not accuracy, holds the step (about
+///     the stability interval on the negative real axis; Hairer's stiffness test);
 ///   extra_stages, extra_c, extra_a[e][s + 1 + e]: stages only the dense output needs;
 ///   dense_rows, dense[r][s + 1 + extra_stages]: the continuous extension (see dense_state).
 template <class M>
@@ -69,6 +71,7 @@ concept ExplicitRungeKuttaMethod = requires {
   { M::min_step_factor } -> std::convertible_to<double>;
   { M::max_step_factor } -> std::convertible_to<double>;
   { M::stabilization_exponent } -> std::convertible_to<double>;
+  { M::stiffness_bound } -> std::convertible_to<double>;
   M::c[0] + M::a[0][0] + M::b[0] + M::error_weights[0] + M::dense[0][0];
 };
 
@@ -109,6 +112,7 @@ class ExplicitRungeKutta {
     y_trial_ = y_n_;
     y_dense_ = y_n_;
     stage_ = y_n_;
+    y_stiffness_ = y_n_;
     for (auto& k : k_) k = y_n_;
     for (auto& term : dense_terms_) term = y_n_;
     vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
@@ -147,6 +151,7 @@ class ExplicitRungeKutta {
     for (int i = 1; i < s; ++i) {
       combine(stage_, y_n_, h, Method::a[i], i);
       if (!derivative(t_n_ + Method::c[i] * h, stage_, k_[i])) return false;
+      if (i == stiffness_stage) y_stiffness_ = stage_;
     }
     if constexpr (Method::last_stage_is_new_point)
       y_new_ = stage_;
@@ -210,6 +215,7 @@ class ExplicitRungeKutta {
   /// after a rejection.
   void accept() {
     commit();
+    detect_stiffness();
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     constexpr double beta = Method::stabilization_exponent;
     constexpr double alpha = 1.0 / (Method::error_order + 1) - 0.75 * beta;
@@ -282,6 +288,15 @@ class ExplicitRungeKutta {
                                     "elements' parameters");
   }
 
+  /// Whether the step size has been held by stability rather than accuracy for a while
+  /// (Hairer's test, below): the problem is stiff, and an implicit method would take longer
+  /// steps.
+  bool stiffness_detected() const { return stiff_steps_ >= stiff_steps_needed; }
+  /// The last estimate of h |lambda|, lambda the dominant eigenvalue of the Jacobian of f.
+  double stiffness_estimate() const { return h_lambda_; }
+
+  /// Its name in integrator_names().
+  static std::string name() { return Method::name; }
   bool adaptive() const { return true; }
   double time() const { return t_n_; }
   double proposed_step() const { return proposed_step_; }
@@ -308,6 +323,33 @@ class ExplicitRungeKutta {
       Method::last_stage_is_new_point ? HeldMatrix::at_point
       : Method::c[s - 1] == 1.0       ? HeldMatrix::near_point
                                       : HeldMatrix::none;
+
+  /// The last stage at t_n + h other than the new point itself: f there and at the new point
+  /// give the stiffness estimate.
+  static constexpr int stiffness_stage = [] {
+    int stage = 0;
+    for (int i = 1; i < s; ++i)
+      if (Method::c[i] == 1.0 && !(Method::last_stage_is_new_point && i == s - 1)) stage = i;
+    return stage;
+  }();
+  static_assert(stiffness_stage > 0, "the tableau needs a stage at t_n + h for the stiffness test");
+  static constexpr int stiff_steps_needed = 15;    // as in Hairer's DOPRI5 and DOP853
+  static constexpr int non_stiff_steps_reset = 6;  // steps without the sign that clear the count
+
+  /// Hairer, Norsett & Wanner, Sect. IV.2: h |lambda| ~ h |f(y_1) - f(y_s)| / |y_1 - y_s| for two
+  /// states at the step's end (the new point and the last stage there). Beyond the method's
+  /// stability boundary on the negative real axis, stability holds the step, not accuracy.
+  void detect_stiffness() {
+    const double distance = (y_trial_ - y_stiffness_).norm();
+    if (!(distance > 0.0)) return;
+    h_lambda_ = h_ * (k_[new_point] - k_[stiffness_stage]).norm() / distance;
+    if (h_lambda_ > Method::stiffness_bound) {
+      non_stiff_steps_ = 0;
+      ++stiff_steps_;
+    } else if (++non_stiff_steps_ >= non_stiff_steps_reset) {
+      stiff_steps_ = 0;
+    }
+  }
 
   /// out = base + h sum_{j < count} weights_j k_j.
   template <std::size_t N>
@@ -445,6 +487,9 @@ class ExplicitRungeKutta {
   double previous_error_ = 1e-4;  // of the last accepted step, for PI control
   bool rejected_ = false;         // the last attempt was rejected
   Eigen::VectorXd y_n_, y_new_, stage_, vdot_n_, lambda_n_;
+  Eigen::VectorXd y_stiffness_;  // the state of stiffness_stage in the last attempt
+  double h_lambda_ = 0.0;
+  int stiff_steps_ = 0, non_stiff_steps_ = 0;
   // Stage derivatives of the last attempt, f at its projected end, the extra dense stages.
   std::array<Eigen::VectorXd, num_derivatives> k_;
   // The last attempt's projected end state, its v' and lambda; a dense-output point.

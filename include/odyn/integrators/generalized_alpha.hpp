@@ -300,6 +300,8 @@ class GeneralizedAlphaMethod {
     throw SolverError(t_failed, message);
   }
 
+  /// Its name in integrator_names().
+  std::string name() const { return settings_.hht ? "hht" : "generalized-alpha"; }
   bool adaptive() const { return settings_.adaptive; }
   double time() const { return t_n_; }
   double proposed_step() const { return proposed_step_; }
