@@ -330,16 +330,15 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     counts the integrator's setup only.
 
     integrator: by default "auto", or "generalized-alpha" when `step` is given without rtol
-    or atol (a fixed step) or when `adaptive` is given. "auto" controls the error to rtol and atol (default 1e-6): dop853
-    while it does well, bdf from where the problem turns stiff (if bdf's steps are longer),
-    and generalized-alpha at `step` (default 1e-4 s) from the start if either fails, at a
-    singular configuration say; `summary["integrator"]` says what ran and
-    `summary["integrator_choice"]` why. Or a name of `odyn.integrators()`: "generalized-alpha" (Chung-Hulbert, from
-    rho_inf) or "hht" take fixed steps of at most `step` (a step whose Newton iteration fails
-    is tried again in halves, down to step / 16, and grows back after a few good steps), or,
-    with error control (`adaptive`;
-    on by default when rtol or atol is given), steps from the local error estimate starting at
-    `step`; "dopri5" and "dop853" (explicit Dormand-Prince 5(4) and 8(5,3), positions projected
+    or atol (a fixed step) or when `adaptive` is given. "auto" controls the error to rtol and
+    atol (default 1e-6): dop853 while it does well, bdf from where the problem turns stiff (if
+    bdf's steps are longer), and generalized-alpha at `step` (default 1e-4 s) from the start
+    if either fails, at a singular configuration say; `summary["integrator"]` says what ran
+    and `summary["integrator_choice"]` why. Or a name of `odyn.integrators()`:
+    "generalized-alpha" (Chung-Hulbert, from rho_inf) or "hht" take fixed steps of at most
+    `step` (a step whose Newton iteration fails is tried again in halves, down to step / 16,
+    and grows back after a few good steps), or, with error control (`adaptive`; on by default
+    when rtol or atol is given), steps from the local error estimate starting at `step`; "dopri5" and "dop853" (explicit Dormand-Prince 5(4) and 8(5,3), positions projected
     onto the constraints to `projection_tolerance`) and "bdf" always control their error;
     "adams" (explicit Adams-Bashforth of `order` 1 to 6, default 5) takes fixed steps of at most
     `step`, for problems that are not stiff. rtol and atol (default 1e-6) are the local error
