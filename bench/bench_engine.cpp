@@ -84,6 +84,7 @@ void Run(benchmark::State& state) {
     engine::Engine e = engine::build();
     odyn::Workspace<Model> ws(e.model);
     odyn::DynamicsSettings settings;
+    settings.integrator = "generalized-alpha";
     settings.step = h;
     if (adams_order > 0) settings.integrator = "adams", settings.adams.order = adams_order;
     std::size_t k = 0;

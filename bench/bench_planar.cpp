@@ -64,6 +64,7 @@ void SliderCrankRunPlanar(benchmark::State& state) {
     auto e = engine::planar::build();
     odyn::Workspace<engine::planar::Model> ws(e.model);
     odyn::DynamicsSettings settings;
+    settings.integrator = "generalized-alpha";
     settings.step = h;
     std::size_t k = 0;
     z_error = 0.0;
@@ -90,6 +91,7 @@ void AndrewsRun(benchmark::State& state) {
     andrews::Mechanism m = andrews::build();
     odyn::Workspace<andrews::Model> ws(m.model);
     odyn::DynamicsSettings settings;
+    settings.integrator = "generalized-alpha";
     settings.step = h;
     settings.t_end = 0.03;
     settings.output_interval = 0.03;
