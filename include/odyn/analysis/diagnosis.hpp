@@ -103,4 +103,12 @@ std::string rank_drop(const Model& model, const Workspace<Model>& ws) {
          "and its branches cross.";
 }
 
+/// rank_drop at the state an integrator's coordinates hold; joint coordinates first fill in
+/// every joint's blocks there (complete_workspace), as an absolute-coordinate run leaves them.
+template <class Model, class Coordinates>
+std::string rank_drop(const Model& model, Workspace<Model>& ws, Coordinates& coordinates) {
+  if constexpr (requires { coordinates.complete_workspace(); }) coordinates.complete_workspace();
+  return rank_drop(model, ws);
+}
+
 }  // namespace odyn::diagnosis

@@ -580,20 +580,12 @@ class BdfMethod {
     }
   }
 
-  /// diagnosis::rank_drop at the workspace's state (in joint coordinates, after filling in
-  /// every joint's blocks there): what to say about a singular configuration, if it is one.
-  std::string singular_configuration() {
-    if constexpr (requires(Coordinates & c) { c.complete_workspace(); })
-      coordinates_.complete_workspace();
-    return diagnosis::rank_drop(model_, ws_);
-  }
-
   std::string failure_message() {
     if (!all_finite(rhs_) || !all_finite(ws_.force))
       return "bdf: Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
-    const std::string singular = singular_configuration();
+    const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
     const std::string head =
         "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
         " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) + " s (" +

@@ -233,14 +233,6 @@ class ExplicitRungeKutta {
         std::min(control_.max_step, h_ < proposed_step_ ? std::max(proposed_step_, grown) : grown);
   }
 
-  /// diagnosis::rank_drop at the workspace's state (in joint coordinates, after filling in
-  /// every joint's blocks there): what to say about a singular configuration, if it is one.
-  std::string singular_configuration() {
-    if constexpr (requires(Coordinates & c) { c.complete_workspace(); })
-      coordinates_.complete_workspace();
-    return diagnosis::rank_drop(model_, ws_);
-  }
-
   /// Rejects the last attempt and shrinks the step; throws once it is hopelessly short.
   void reject() {
     ++statistics_.rejected_steps;
@@ -249,7 +241,7 @@ class ExplicitRungeKutta {
         h_ * std::min(0.9, step_factor(error_, Method::error_order, Method::min_step_factor, 0.9));
     rollback();
     if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_))) {
-      const std::string singular = singular_configuration();
+      const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
       const std::string head = std::string(Method::name) + ": the step size fell below " +
                                to_text(control_.min_step) + " s";
       if (!singular.empty())

@@ -615,20 +615,12 @@ class GeneralizedAlphaMethod {
     return {ordinary, std::min(ordinary, std::max(following, rounding))};
   }
 
-  /// diagnosis::rank_drop at the workspace's state (in joint coordinates, after filling in
-  /// every joint's blocks there): what to say about a singular configuration, if it is one.
-  std::string singular_configuration() {
-    if constexpr (requires(Coordinates & c) { c.complete_workspace(); })
-      coordinates_.complete_workspace();
-    return diagnosis::rank_drop(model_, ws_);
-  }
-
   std::string failure_message() {
     if (!all_finite(residual_))
       return "Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
-    const std::string singular = singular_configuration();
+    const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
     return "Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
            " iterations (" + diagnosis::worst_constraint(model_, ws_) +
            diagnosis::strongest_force(model_, ws_) + ")." + singular + " " +
