@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _core
 from .results import ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Interrupted, Result, integrators
-from .scene import Scene, load, write_table
+from .scene import Scene, chosen_integrator, load, write_table
 
 
 class _Parser(argparse.ArgumentParser):
@@ -92,18 +92,22 @@ class _Progress:
 
 def describe_integrator(settings: dict) -> str:
     """"generalized-alpha (rho_inf 0.9), h = 0.0001 s" or, with error control, "... rtol ..."."""
-    name = settings["integrator"]
-    text = name + (f" (rho_inf {settings['rho_inf']:g})" if name in ADAPTIVE_OPTIONAL else "")
+    name = chosen_integrator(settings)
+    step = settings.get("step", 1e-4)
+    text = name + (f" (rho_inf {settings.get('rho_inf', 0.9):g})"
+                   if name in ADAPTIVE_OPTIONAL else "")
     adaptive = settings.get("adaptive")
     if adaptive is None:  # as simulate(): tolerances turn on error control
         adaptive = name not in ADAPTIVE_OPTIONAL or "rtol" in settings or "atol" in settings
     if adaptive:
         text += (f", error control rtol {settings.get('rtol', 1e-6):g}, atol "
-                 f"{settings.get('atol', 1e-6):g}, first step {settings['step']:g} s")
+                 f"{settings.get('atol', 1e-6):g}")
+        if name != "auto":
+            text += f", first step {step:g} s"
         if settings.get("max_step"):
             text += f", max step {settings['max_step']:g} s"
         return text
-    return text + f", h = {settings['step']:g} s"
+    return text + f", h = {step:g} s"
 
 
 def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> List[str]:
@@ -157,7 +161,7 @@ def _run(args: argparse.Namespace) -> int:
         value = getattr(args, key)
         if value is not None:
             settings[key] = value
-    if settings["integrator"] not in ADAPTIVE_OPTIONAL:
+    if chosen_integrator(settings) not in ADAPTIVE_OPTIONAL:
         settings.pop("adaptive", None)  # the scene's choice for another integrator
     elif args.rtol is not None or args.atol is not None:
         settings["adaptive"] = True  # as the C++ examples: tolerances turn on error control

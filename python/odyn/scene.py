@@ -10,11 +10,12 @@
       "drivers": [{"type": "revolute_driver", "name": "motor", "joint": "bearing",
                    "motion": {"type": "constant_velocity", "rate": 10.0}}],
       "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
-      "analysis": {"integrator": "generalized-alpha", "rho_inf": 0.9, "step": 1e-4,
-                   "t_end": 1.0, "output_interval": 1e-3},   (+ rtol, atol, max_step,
-                   adaptive, newton_rtol, newton_atol, constraint_tolerance, max_iterations,
-                   projection_tolerance, order, coordinates ("absolute" or "joint"); the
-                   integrator is a name of odyn.integrators())
+      "analysis": {"t_end": 1.0, "output_interval": 1e-3},   (+ integrator, rho_inf, step,
+                   rtol, atol, max_step, adaptive, newton_rtol, newton_atol,
+                   constraint_tolerance, max_iterations, projection_tolerance, order,
+                   coordinates ("absolute" or "joint"); the integrator is a name of
+                   odyn.integrators(); left out, it is simulate()'s choice: auto, or
+                   generalized-alpha when a step is given without rtol and atol)
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"}, ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
@@ -48,9 +49,11 @@ SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _sch
 SECTIONS = SPACE_SECTIONS["spatial"]
 TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "analysis",
             "outputs", "figures")
-ANALYSIS_DEFAULTS: Dict[str, Any] = {"integrator": "generalized-alpha", "rho_inf": 0.9,
-                                     "step": 1e-4, "t_end": 1.0, "output_interval": 1e-3}
-ANALYSIS_OPTIONAL = ("rtol", "atol", "max_step", "adaptive", "newton_rtol", "newton_atol",
+ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
+# Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
+# or generalized-alpha (rho_inf 0.9) when a step is given without tolerances.
+ANALYSIS_OPTIONAL = ("integrator", "rho_inf", "step", "rtol", "atol", "max_step", "adaptive",
+                     "newton_rtol", "newton_atol",
                      "constraint_tolerance", "max_iterations", "projection_tolerance", "order",
                      "coordinates", "linear_solver")
 
@@ -144,22 +147,22 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
     for key, default in ANALYSIS_DEFAULTS.items():
         value = d.get(key, default)
         w = f"{where}.{key}"
-        if key == "integrator":
-            out[key] = check_choice(value, w, list(integrators()))
-        elif key == "rho_inf":
-            out[key] = check_number(value, w, minimum=0.0)
-            if out[key] > 1.0:
-                fail(w, f"expected a number in [0, 1], got {out[key]:g}")
-        elif key == "t_end":
+        if key == "t_end":
             out[key] = check_number(value, w, minimum=0.0)
         else:
             out[key] = check_number(value, w, positive=True)
     for key in ANALYSIS_OPTIONAL:
         if key in d:
-            if key == "adaptive":
+            if key == "integrator":
+                out[key] = check_choice(d[key], f"{where}.{key}", list(integrators()))
+            elif key == "rho_inf":
+                out[key] = check_number(d[key], f"{where}.{key}", minimum=0.0)
+                if out[key] > 1.0:
+                    fail(f"{where}.{key}", f"expected a number in [0, 1], got {out[key]:g}")
+            elif key == "adaptive":
                 if not isinstance(d[key], bool):
                     fail(f"{where}.{key}", f"expected true or false, got {d[key]!r}")
-                if out["integrator"] not in ADAPTIVE_OPTIONAL:
+                if out.get("integrator", "generalized-alpha") not in ADAPTIVE_OPTIONAL:
                     fail(f"{where}.{key}", f"applies to {' and '.join(ADAPTIVE_OPTIONAL)}; "
                          f"{out['integrator']} chooses its steps itself (leave it out)")
                 out[key] = d[key]
@@ -179,6 +182,16 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
             else:
                 out[key] = check_number(d[key], f"{where}.{key}", positive=True)
     return out
+
+
+def chosen_integrator(settings: Mapping[str, Any]) -> str:
+    """The integrator simulate() runs for these settings: the one named, else generalized-alpha
+    when a step is given without tolerances (or `adaptive` is), else auto."""
+    if settings.get("integrator") is not None:
+        return settings["integrator"]
+    fixed_step = settings.get("step") is not None and settings.get("rtol") is None and \
+        settings.get("atol") is None
+    return "generalized-alpha" if fixed_step or settings.get("adaptive") is not None else "auto"
 
 
 def _check_component(d: Dict[str, Any], where: str, quantity: str, planar: bool) -> None:

@@ -172,3 +172,27 @@ def test_cli_npz_and_overrides(tmp_path):
                                  "phid_norm"]
     assert len(data["t"]) == 21 and data["t"][-1] == pytest.approx(0.02)
     assert "hht" in run.stdout and (tmp_path / "all.png").stat().st_size > 10_000
+
+
+def test_a_scene_without_an_integrator_takes_simulates_default(engine_dict, tmp_path):
+    # Left out, the integrator is simulate()'s choice: auto, or generalized-alpha for a step
+    # given without tolerances; the CLI says which, and both meet the crank angle of the
+    # scene's own generalized-alpha run (h = 1e-4, good to about 1e-5 rad at 0.05 s).
+    given = odyn.loads(json.dumps(engine_dict)).simulate(t_end=0.05)
+    for removed, expected in (("step", "dop853"), (None, "generalized-alpha")):
+        d = copy.deepcopy(engine_dict)
+        del d["analysis"]["integrator"], d["analysis"]["rho_inf"]
+        if removed:
+            del d["analysis"][removed]
+        scene = odyn.loads(json.dumps(d))
+        assert "integrator" not in scene.analysis
+        assert "integrator" not in scene.to_dict()["analysis"]
+        result = scene.simulate(t_end=0.05)
+        assert result.summary["integrator"] == expected
+        np.testing.assert_allclose(result.q[-1], given.q[-1], atol=1e-5)
+        file = tmp_path / "scene.json"
+        file.write_text(json.dumps(d))
+        run = subprocess.run([sys.executable, "-m", "odyn", "run", str(file), "--t-end", "0.02"],
+                             capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.splitlines()[1].startswith("auto" if removed else "generalized-alpha")
