@@ -13,8 +13,9 @@ from typing import List, NoReturn, Optional, Tuple
 import numpy as np
 
 from . import _core
-from .results import ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Interrupted, Result, integrators
-from .scene import Scene, chosen_integrator, load, write_table
+from .results import (ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Interrupted, Result, chosen_integrator,
+                      integrators)
+from .scene import Scene, load, write_table
 
 
 class _Parser(argparse.ArgumentParser):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import warnings
-from typing import Any, Callable, Dict, List, NamedTuple, Optional
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional
 
 import numpy as np
 
@@ -13,6 +13,17 @@ from .model import BaseModel
 
 #: Integrators whose step is fixed unless `adaptive` (error control) is on.
 ADAPTIVE_OPTIONAL = ("generalized-alpha", "hht")
+
+
+def chosen_integrator(settings: Mapping[str, Any]) -> str:
+    """The integrator simulate() runs for these settings (a dict of its keyword arguments): the
+    one named, else generalized-alpha when a step is given without rtol and atol, or when
+    `adaptive` (generalized-alpha's option) is, else auto."""
+    if settings.get("integrator") is not None:
+        return settings["integrator"]
+    fixed_step = settings.get("step") is not None and settings.get("rtol") is None and \
+        settings.get("atol") is None
+    return "generalized-alpha" if fixed_step or settings.get("adaptive") is not None else "auto"
 
 
 def integrators() -> Dict[str, str]:
@@ -369,9 +380,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     as its `result` attribute. A consistently over-constrained mechanism runs with minimum-norm
     multipliers and a `RedundantConstraintsWarning` (see `Result.redundant_equations`).
     """
-    if integrator is None:  # `adaptive` is generalized-alpha's option
-        fixed_step = step is not None and rtol is None and atol is None
-        integrator = "generalized-alpha" if fixed_step or adaptive is not None else "auto"
+    if integrator is None:
+        integrator = chosen_integrator({"step": step, "rtol": rtol, "atol": atol,
+                                        "adaptive": adaptive})
     if step is None:
         step = 1e-4
     settings = _settings(step, t_end, output_interval, integrator, rho_inf, rtol, atol,

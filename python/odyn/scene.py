@@ -184,16 +184,6 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
     return out
 
 
-def chosen_integrator(settings: Mapping[str, Any]) -> str:
-    """The integrator simulate() runs for these settings: the one named, else generalized-alpha
-    when a step is given without tolerances (or `adaptive` is), else auto."""
-    if settings.get("integrator") is not None:
-        return settings["integrator"]
-    fixed_step = settings.get("step") is not None and settings.get("rtol") is None and \
-        settings.get("atol") is None
-    return "generalized-alpha" if fixed_step or settings.get("adaptive") is not None else "auto"
-
-
 def _check_component(d: Dict[str, Any], where: str, quantity: str, planar: bool) -> None:
     """The component of a vector quantity; none for a planar angle, rate or torque."""
     if planar and quantity in PLANAR_SCALARS:
