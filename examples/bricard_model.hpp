@@ -7,6 +7,9 @@
 // `length`). Grubler's count gives 6 x 5 - 5 x 6 = 0 degrees of freedom, yet the linkage moves
 // with one: Phi_q (30 equations) has rank 29 at every pose, one equation is always redundant.
 // Released at rest under gravity along -z it folds and swings back (no friction).
+// With `cylinder`, joint J6 is a cylindrical joint instead: its fifth equation (no sliding
+// along the axis) is the one the other joints already impose, so the linkage moves the same
+// way with 29 independent equations: the same mechanism without its redundancy.
 
 #include <array>
 #include <string>
@@ -23,14 +26,16 @@ struct Parameters {
   double mass = 1.0;                  // kg, every moving bar
   double radius = 0.01;               // m, of the bars (their inertia about their own axis)
   Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2
+  bool cylinder = false;              // J6 cylindrical (no redundant equation)
 };
 
-using Model = sp::Model<sp::Revolute, sp::RevoluteDriver, sp::Gravity>;
+using Model = sp::Model<sp::Revolute, sp::Cylindrical, sp::RevoluteDriver, sp::Gravity>;
 
 struct Linkage {
   Model model;
   std::array<odyn::BodyId, 5> bars;
   std::array<odyn::Handle<sp::Revolute>, 6> joints;  // J1 (ground-bar 1) ... J6 (bar 5-ground)
+  odyn::Handle<sp::Cylindrical> cylinder;            // J6 instead, with Parameters::cylinder
 };
 
 /// The corners V1..V6 of the initial pose, and the joint axes there.
@@ -65,8 +70,11 @@ inline Linkage build(const Parameters& p = {}) {
     const odyn::BodyId b = i == 5 ? odyn::ground : l.bars[i];
     const Vector3d on_a = i == 0 ? v[0] : Vector3d(0.5 * (v[i] - v[i - 1]));
     const Vector3d on_b = i == 5 ? v[5] : Vector3d(0.5 * (v[i] - v[i + 1]));
-    l.joints[i] =
-        l.model.add(sp::Revolute("J" + std::to_string(i + 1), a, {on_a, w[i]}, b, {on_b, w[i]}));
+    const std::string name = "J" + std::to_string(i + 1);
+    if (i == 5 && p.cylinder)
+      l.cylinder = l.model.add(sp::Cylindrical(name, a, {on_a, w[i]}, b, {on_b, w[i]}));
+    else
+      l.joints[i] = l.model.add(sp::Revolute(name, a, {on_a, w[i]}, b, {on_b, w[i]}));
   }
   l.model.add(sp::Gravity("gravity", p.gravity));
   return l;

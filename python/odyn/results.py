@@ -365,7 +365,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     dynamics); reactions and outputs are the same as in absolute coordinates. Generalized-alpha,
     hht and bdf there leave the spring and damper blocks that join two bodies out of Newton's
     matrix: stiff ones converge better in absolute coordinates. Redundant loop closures are
-    refused (absolute coordinates handle them).
+    pinned (their multipliers stay zero; absolute coordinates report minimum-norm ones).
 
     linear_solver: the factorization of the linear systems of the assembly and the steps.
     "auto" (the default) picks by size and pattern: dense kernels for small models (tens of

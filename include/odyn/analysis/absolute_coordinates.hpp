@@ -190,9 +190,13 @@ class AbsoluteCoordinates {
   bool factorize(const IterationFactors& factors, int slot = 0) {
     return solvers_[slot].factorize(model_, ws_, factors);
   }
-  /// x = the factorized matrix's inverse times rhs (velocities, then equations).
+  /// x = the factorized matrix's inverse times rhs (velocities, then equations): a Newton
+  /// correction, which leaves the multipliers of pinned redundant equations where they are.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, int slot = 0) {
-    solvers_[slot].solve(rhs, x);
+    if constexpr (requires { solvers_[slot].solve_correction(rhs, x); })
+      solvers_[slot].solve_correction(rhs, x);
+    else
+      solvers_[slot].solve(rhs, x);
   }
   /// Equations that repeat others in the last factorization (run with minimum-norm multipliers).
   int rank_deficiency(int slot = 0) const {
@@ -202,9 +206,25 @@ class AbsoluteCoordinates {
   double geometric_share() const { return solvers_[0].geometric_share(); }
   /// With redundant equations, the multipliers of least norm among those that give the same
   /// constraint forces (their reactions are then one choice among many), unless the solver
-  /// pinned the redundant ones (large models).
-  void make_multipliers_unique(int slot = 0) {
-    if (needs_minimum_norm_multipliers(solvers_[slot])) make_multipliers_minimum_norm(model_, ws_);
+  /// pinned the redundant ones (large models), or pinned them for the corrections alone (small
+  /// models: then the iteration never moved them along the null space, and outputs, solved
+  /// outright, are minimum-norm). `exact` computes them afresh from the current Jacobian in
+  /// every case (an output that is not solved outright).
+  void make_multipliers_unique(int slot = 0, bool exact = false) {
+    Solver& solver = solvers_[slot];
+    if (!needs_minimum_norm_multipliers(solver)) return;
+    if constexpr (requires { solver.corrections_pinned(); })
+      if (!exact && solver.corrections_pinned()) return;
+    make_multipliers_minimum_norm(model_, ws_);
+  }
+
+  /// True if Newton's corrections with the slot's last factorization contract as a regular
+  /// matrix's do: no equation repeats others, or those that do keep their multipliers (see
+  /// solve()).
+  bool regular_corrections(int slot = 0) const {
+    if constexpr (requires { solvers_[slot].corrections_pinned(); })
+      if (solvers_[slot].corrections_pinned()) return true;
+    return rank_deficiency(slot) == 0;
   }
 
   /// max |M^-1 r| by the mass matrix's diagonal: a cheap estimate of the next Newton correction

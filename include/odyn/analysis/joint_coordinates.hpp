@@ -54,8 +54,8 @@
 // (see factorize(const IterationFactors&)). BDF keeps three such factorizations apart (slots:
 // its Newton matrix, its projection's and its outputs').
 //
-// Limits: loop closures must be independent (a redundant closure, as in
-// Bricard's mechanism, is refused with its joints named: absolute coordinates handle it).
+// Redundant closures (Bricard's mechanism) are found at the start and their equations pinned
+// (see check_closures): the factorizations cost what the model without them would.
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -79,6 +79,7 @@
 #include "odyn/linalg/all_finite.hpp"
 #include "odyn/linalg/linear_solver.hpp"
 #include "odyn/linalg/pivoted_lu.hpp"
+#include "odyn/linalg/rank_revealing_qr.hpp"
 #include "odyn/linalg/saddle_point_ldlt.hpp"
 
 namespace odyn {
@@ -164,7 +165,6 @@ class JointCoordinates {
       "converge better.";
 
   /// Builds the tree at the workspace's (assembled) state and takes that state as the start.
-  /// Throws ModelError if the loop closures are redundant there.
   /// (The closures' Schur complement is small and dense: `linear_solver` is not used.)
   /// Factorizations kept apart (see AbsoluteCoordinates): BDF's Newton matrix, its
   /// projection's and its outputs'. The operations without a slot use the one used last.
@@ -272,6 +272,10 @@ class JointCoordinates {
       add_closure_wrenches(multiplier_, -1.0, force_);  // p = -(C^T e_j)
       tree_solve(false, increment_, motion_);
       closure_rates(motion_, schur_.col(j));
+    }
+    if (!pinned_rows_.empty()) {
+      pin_closure_rows(schur_, 0, schur_.diagonal().cwiseAbs().maxCoeff());
+      schur_.triangularView<Eigen::StrictlyUpper>() = schur_.transpose();
     }
     schur_llts_[slot_].compute(schur_);
     return schur_llts_[slot_].info() == Eigen::Success;
@@ -524,11 +528,12 @@ class JointCoordinates {
     saddle_solve(true, false, closure_rhs_, x.head(n), x.tail(m), &joint_rhs_);
   }
 
-  // Redundant closures are refused at the start (check_closures), and the matrix leaves out
-  // the geometric stiffness.
+  // Redundant closures are pinned (check_closures): no minimum-norm projection; the matrix
+  // leaves out the geometric stiffness.
   int rank_deficiency(int /*slot*/ = 0) const { return 0; }
   double geometric_share() const { return 0.0; }
-  void make_multipliers_unique(int /*slot*/ = 0) {}
+  void make_multipliers_unique(int /*slot*/ = 0, bool /*exact*/ = false) {}
+  bool regular_corrections(int /*slot*/ = 0) const { return true; }
 
   /// max |A^-1 r|, one solve along the tree (the closures left out): the next Newton
   /// correction of theta'' for the residual r, about.
@@ -847,6 +852,7 @@ class JointCoordinates {
           angular(rows[r]) += Algebra::moment(nodes_[j].offset, linear(rows[r]));
       }
     }
+    pin_closure_rows(kkt_, n, -1.0);  // a multiplier's pivot is negative
     return kkt_ldlts_[slot_].compute(kkt_);
   }
 
@@ -920,6 +926,7 @@ class JointCoordinates {
     if (num_equations() == 0) return;
     closure_rates(motion_, mu);
     mu -= s;
+    for (const int row : pinned_rows_) mu[row] = 0.0;
     // By the triangular factors: LLT's own solveInPlace copies a Ref into a new vector.
     schur_llts_[slot_].matrixL().solveInPlace(mu);
     schur_llts_[slot_].matrixU().solveInPlace(mu);
@@ -964,6 +971,7 @@ class JointCoordinates {
     } else {
       solution_.head(n).setZero();
     }
+    for (const int row : pinned_rows_) solution_[n + row] = 0.0;
     kkt_ldlts_[slot_].solve_in_place(solution_);
     x = solution_.head(n);
     mu = solution_.tail(num_equations());
@@ -1201,8 +1209,14 @@ class JointCoordinates {
     update_velocities();
   }
 
-  /// Refuses closures whose equations repeat each other at the start: the rank of C, whose
-  /// rows C^T e_j = J^T (G^T e_j) are the closures' unit wrenches summed up the tree.
+  /// Finds the closure equations that repeat others at the start (Bricard's linkage, two
+  /// coaxial hinges closing one loop): a column-pivoted QR of C^T, whose columns
+  /// C^T e_j = J^T (G^T e_j) are the closures' unit wrenches summed up the tree, pivots them
+  /// last. They are pinned from then on (see pin_closure_rows): their multipliers stay zero and
+  /// the others carry the loads, one valid choice of reactions among many (absolute
+  /// coordinates give the minimum-norm one). An equation that stops repeating the others later
+  /// is then not enforced, and the constraint residual, which every integrator checks over all
+  /// of them, names it.
   void check_closures() {
     const Eigen::Index m = num_equations();
     if (m == 0) return;
@@ -1220,15 +1234,22 @@ class JointCoordinates {
           add_shifted_force(force_[i], nodes_[i].offset, force_[node.parent_node]);
       }
     }
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(jacobian);
-    lu.setThreshold(1e-10);
-    if (lu.rank() < m) {
-      std::string names;
-      for (const auto& name : closure_names_) names += (names.empty() ? "'" : ", '") + name + "'";
-      throw ModelError("joint coordinates",
-                       "the loop-closure equations of " + names + " are redundant (rank " +
-                           std::to_string(lu.rank()) + " of " + std::to_string(m) +
-                           "); use absolute coordinates, which run with redundant constraints");
+    const RankRevealingQr qr(jacobian.transpose(), rank_tolerance);
+    const std::vector<int>& order = qr.column_order();
+    pinned_rows_.assign(order.begin() + qr.rank(), order.end());
+    std::sort(pinned_rows_.begin(), pinned_rows_.end());
+  }
+
+  /// Pins the redundant closure rows in a factorization's matrix, whose multipliers' block
+  /// starts at row and column `offset` (lower triangle): their rows and columns cleared, the
+  /// diagonal set to `diagonal`, so that a solve with zero right-hand side there leaves their
+  /// multipliers at zero.
+  void pin_closure_rows(Eigen::MatrixXd& matrix, Eigen::Index offset, double diagonal) const {
+    for (const int row : pinned_rows_) {
+      const Eigen::Index r = offset + row;
+      matrix.row(r).head(r).setZero();
+      matrix.col(r).tail(matrix.rows() - r - 1).setZero();
+      matrix(r, r) = diagonal;
     }
   }
 
@@ -1456,6 +1477,7 @@ class JointCoordinates {
   Eigen::VectorXd velocity_values_;   // (m) C theta' + Phi_t
   Eigen::VectorXd closure_rhs_;       // (m) a saddle-point solve's s
   Eigen::VectorXd multiplier_;        // (m) scratch
+  std::vector<int> pinned_rows_;      // closure equations that repeat others (check_closures)
   Eigen::MatrixXd schur_;             // (m x m) C A^-1 C^T
   bool dense_ = false;                // small: the whole saddle-point matrix (dense_limit)
   Eigen::MatrixXd kkt_;               // (n + m) [A C^T; C 0], lower triangle (dense_)

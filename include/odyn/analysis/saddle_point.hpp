@@ -73,6 +73,27 @@
 
 namespace odyn {
 
+namespace detail {
+/// Largest Schur complement of a pinned row, relative to the largest diagonal entry of
+/// B A^-1 B^T, for which the row still counts as repeating the others (see
+/// DenseSaddlePoint::factorize_pinned). A row that repeats others at every pose leaves rounding
+/// there, or the distance of a Newton iterate from the constraints: 1e-22 to 1e-12 on
+/// Bricard's linkage, nearly all below 1e-14. A row that repeats others only for an instant,
+/// near a singular configuration, leaves 1e-12 to 1e-10 on the chain of parallelograms, and
+/// goes to the rank-revealing path, whose least-squares solutions carry Newton through the
+/// crossing (pinned there, it stalls at h = 1e-4).
+inline constexpr double repeated_row_tolerance = 1e-13;
+
+/// y - N (N^T N)^-1 N^T y: y without its part in the span of N's columns (work: scratch).
+inline void remove_null_space_part(const Eigen::MatrixXd& null_basis,
+                                   const Eigen::LLT<Eigen::MatrixXd>& gram, Eigen::VectorXd& work,
+                                   Eigen::Ref<Eigen::VectorXd> y) {
+  work.noalias() = null_basis.transpose() * y;
+  gram.solveInPlace(work);
+  y.noalias() -= null_basis * work;
+}
+}  // namespace detail
+
 template <class Model>
 class DenseSaddlePoint {
  public:
@@ -86,23 +107,53 @@ class DenseSaddlePoint {
     matrix_ = Eigen::MatrixXd::Zero(size, size);
     lu_.analyze_pattern(matrix_);
     rank_deficiency_ = 0;
+    pinned_.clear();
+    pinned_solve_ = false;
   }
 
-  /// Factorizes by LU; if the matrix is singular (redundant constraints), by a complete
-  /// orthogonal decomposition whose solve gives the minimum-norm solution. False only if the
-  /// matrix holds non-finite values.
+  /// Factorizes by LU; if the matrix is singular (redundant constraints), by LU with the
+  /// multipliers of the equations that repeat others pinned (see factorize_pinned), else by a
+  /// complete orthogonal decomposition whose solve gives the minimum-norm solution. False only
+  /// if the matrix holds non-finite values.
   bool factorize(const Model& model, const Workspace<Model>& ws, const IterationFactors& f) {
     matrix_.setZero();
     add_iteration_blocks(model, ws, matrix_, f.mass, f.stiffness, f.damping, f.geometric);
     write_jacobian(model, ws, matrix_, n_, 0, true);
     rank_deficiency_ = 0;
+    // A redundant mechanism stays singular at every pose: its rows are tried pinned first.
+    if (!pinned_.empty()) {
+      if (factorize_pinned()) return true;
+      pinned_.clear();
+    }
+    pinned_solve_ = false;
     if (lu_.factorize(matrix_)) return true;
     if (!matrix_.allFinite()) return false;
     rank_deficiency_ = lu_.factorize_rank_revealing(matrix_, rank_tolerance);
+    // The columns the rank-revealing QR pivoted last repeat the others; they must be
+    // multipliers' columns (the velocity ones are independent while A is regular on the null
+    // space of B), else the decomposition stays.
+    const std::vector<int>& order = lu_.rank_revealing_column_order();
+    pinned_.clear();
+    for (auto k = order.size() - static_cast<std::size_t>(rank_deficiency_); k < order.size(); ++k)
+      pinned_.push_back(order[k] - n_);
+    std::sort(pinned_.begin(), pinned_.end());
+    if (pinned_.empty() || pinned_.front() < 0 || !factorize_pinned()) {
+      pinned_.clear();
+      lu_.factorize_rank_revealing(matrix_, rank_tolerance);  // factorize_pinned overwrote it
+    }
     return true;
   }
 
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) { lu_.solve(rhs, solution); }
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    if (!pinned_solve_) return lu_.solve(rhs, solution);
+    work_ = rhs;
+    for (const int row : pinned_) work_[n_ + row] = 0.0;
+    lu_.solve(work_, solution);
+    // The minimum-norm multipliers (see factorize_pinned); x is unchanged.
+    if (minimum_norm_)
+      detail::remove_null_space_part(null_basis_, null_gram_, null_work_,
+                                     solution.tail(work_.size() - n_));
+  }
 
   /// The weight of the geometric stiffness in A is not measured here (see
   /// BlockSchurSaddlePoint::geometric_share): infinity, so an integrator that asked for it keeps
@@ -112,11 +163,81 @@ class DenseSaddlePoint {
   /// Number of dependent rows of the last factorized matrix (0: full rank).
   int rank_deficiency() const { return rank_deficiency_; }
 
+  /// True if the last factorization pinned redundant equations (see factorize_pinned).
+  bool corrections_pinned() const { return pinned_solve_; }
+
+  /// solve() for a Newton correction: after a factorization that pinned redundant equations,
+  /// their multipliers' corrections stay zero (y_P = 0) instead of taking the minimum-norm y,
+  /// so that an iteration never moves the multipliers along the null space of B^T, which turns
+  /// with the pose (they would drift along it from step to step).
+  void solve_correction(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    minimum_norm_ = false;
+    solve(rhs, solution);
+    minimum_norm_ = true;
+  }
+
  private:
+  /// Redundant constraints at the cost of a regular matrix. With P the equations in pinned_
+  /// and K the rest, the matrix with the multipliers y_P pinned (their rows and columns cleared
+  /// but for the diagonal) is factorized by LU. The rows P repeat K if B_P = C B_K: then
+  /// [x; y_K] = [0; C^T e_i] solves it for the right-hand side [B_P^T e_i; 0], and the Schur
+  /// complement of the pinned block, -B_P x, vanishes. That is checked here (against
+  /// detail::repeated_row_tolerance times an estimate of the largest diagonal entry of
+  /// B A^-1 B^T, by A's diagonal), so that a
+  /// row that stops repeating the others (a mechanism leaving a singular configuration) falls
+  /// back to the regular factorization at once. The columns of N = [-C^T; I] span the null
+  /// space of B^T, and a solve's y is made the minimum-norm one by removing its part in that
+  /// space. False if the pinned rows do not all repeat the others or the rest is singular.
+  bool factorize_pinned() {
+    const auto m = matrix_.rows() - n_, k = static_cast<Eigen::Index>(pinned_.size());
+    double largest_diagonal = 0.0, scale = 0.0;  // of A; of B A^-1 B^T (estimated)
+    for (Eigen::Index c = 0; c < n_; ++c)
+      largest_diagonal = std::max(largest_diagonal, std::abs(matrix_(c, c)));
+    for (Eigen::Index row = 0; row < m; ++row) {
+      double diagonal = 0.0;
+      for (Eigen::Index c = 0; c < n_; ++c)
+        if (matrix_(n_ + row, c) != 0.0)
+          diagonal += matrix_(n_ + row, c) * matrix_(n_ + row, c) / std::abs(matrix_(c, c));
+      scale = std::max(scale, diagonal);
+    }
+    pinned_matrix_ = matrix_;
+    for (const int row : pinned_) {
+      pinned_matrix_.row(n_ + row).setZero();
+      pinned_matrix_.col(n_ + row).setZero();
+      pinned_matrix_(n_ + row, n_ + row) = largest_diagonal;
+    }
+    if (!(scale > 0.0) || !std::isfinite(scale) || !lu_.factorize(pinned_matrix_)) return false;
+    null_basis_.resize(m, k);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const int p = pinned_[i];
+      work_.setZero(n_ + m);
+      work_.head(n_) = matrix_.col(n_ + p).head(n_);  // B_p^T
+      lu_.solve(work_, solution_);
+      const double complement = matrix_.row(n_ + p).head(n_).dot(solution_.head(n_));
+      if (!(std::abs(complement) <= detail::repeated_row_tolerance * scale)) return false;
+      null_basis_.col(i) = -solution_.tail(m);
+      null_basis_(p, i) = 1.0;
+    }
+    null_gram_matrix_.noalias() = null_basis_.transpose() * null_basis_;
+    null_gram_.compute(null_gram_matrix_);
+    null_work_.resize(k);
+    rank_deficiency_ = static_cast<int>(k);
+    pinned_solve_ = true;
+    return true;
+  }
+
   int n_ = 0;
   int rank_deficiency_ = 0;
   Eigen::MatrixXd matrix_;  // (n + m) x (n + m)
   DenseLu lu_;
+  std::vector<int> pinned_;                // equations that repeat others (see factorize_pinned)
+  bool pinned_solve_ = false;              // the last factorization pinned them
+  bool minimum_norm_ = true;               // false within solve_correction
+  Eigen::MatrixXd pinned_matrix_;          // matrix_ with their multipliers pinned
+  Eigen::MatrixXd null_basis_;             // (m x k) N, a basis of the null space of B^T
+  Eigen::MatrixXd null_gram_matrix_;       // N^T N
+  Eigen::LLT<Eigen::MatrixXd> null_gram_;  // its factorization
+  Eigen::VectorXd null_work_, work_, solution_;  // scratch
 };
 
 namespace detail {
@@ -301,6 +422,7 @@ class BlockSchurSaddlePoint {
     rank_deficiency_ = 0;
     row_order_ = {};
     kept_pinned_rows_.clear();
+    dense_pinned_.clear();
     pins_doubted_ = false;
     trusted_pivot_ratio_ = singular_pivot_ratio;
   }
@@ -332,6 +454,24 @@ class BlockSchurSaddlePoint {
     if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.rank_deficiency();
     if (path_ == Path::sparse_kkt || whole_ == Whole::sparse) return sparse_kkt_.rank_deficiency();
     return rank_deficiency_;
+  }
+
+  /// True if the last factorization was a dense one that pinned redundant equations (see
+  /// factorize_dense_pinned, DenseSaddlePoint::factorize_pinned): solve_correction then leaves
+  /// their multipliers where they are.
+  bool corrections_pinned() const {
+    if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.corrections_pinned();
+    return path_ == Path::dense_schur && whole_ == Whole::none &&
+           method_ == Method::cholesky_pinned;
+  }
+
+  /// solve() for a Newton correction (see DenseSaddlePoint::solve_correction).
+  void solve_correction(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+    if (path_ == Path::dense_kkt || whole_ == Whole::dense)
+      return dense_.solve_correction(rhs, solution);
+    minimum_norm_ = false;
+    solve(rhs, solution);
+    minimum_norm_ = true;
   }
 
   /// True if the last factorization pinned the multipliers of redundant equations (see
@@ -419,6 +559,13 @@ class BlockSchurSaddlePoint {
         solution.tail(m_) = work_m_;
         schur_lu_.solve_in_place(solution.tail(m_));
         break;
+      case Method::cholesky_pinned:  // the minimum-norm y (see factorize_dense_pinned)
+        for (const int row : dense_pinned_) work_m_[row] = 0.0;
+        solution.tail(m_) = work_m_;
+        schur_cholesky_.solve_in_place(solution.tail(m_));
+        if (minimum_norm_)
+          detail::remove_null_space_part(null_basis_, null_gram_, null_work_, solution.tail(m_));
+        break;
       case Method::minimum_norm:
         schur_minimum_norm_.solve(work_m_, work_y_, work_qr_);
         solution.tail(m_) = work_y_;
@@ -440,7 +587,7 @@ class BlockSchurSaddlePoint {
   }
 
  private:
-  enum class Method { cholesky, sparse_cholesky, sparse_pinned, lu, minimum_norm };
+  enum class Method { cholesky, cholesky_pinned, sparse_cholesky, sparse_pinned, lu, minimum_norm };
   enum class Path { dense_schur, sparse_schur, dense_kkt, sparse_kkt };
   /// Which whole-matrix factorization stands in for a Schur path's, if any.
   enum class Whole { none, dense, sparse };
@@ -774,14 +921,21 @@ class BlockSchurSaddlePoint {
     if (mismatch > pinned_consistency * scale) pins_doubted_ = true;
   }
 
-  /// Factorizes the assembled S: Cholesky, else LU, else (singular) a complete orthogonal
-  /// decomposition.
+  /// Factorizes the assembled S: Cholesky, else LU, else (singular) Cholesky with the rows that
+  /// repeat others pinned, else a complete orthogonal decomposition.
   bool factorize_schur() {
     rank_deficiency_ = 0;
+    const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
+    // Rows that repeated others in the last factorization are tried first: a redundant
+    // mechanism (Bricard's) stays singular at every pose, and trying the regular Cholesky first
+    // would cost a failed factorization each time.
+    if (!dense_pinned_.empty()) {
+      if (factorize_dense_pinned(largest_diagonal)) return true;
+      dense_pinned_.clear();
+    }
     // The fast path: Cholesky on the lower triangle. Its pivots are the diagonal of L squared,
     // and the smallest one bounds the smallest eigenvalue of S from above, so a tiny pivot flags
     // a singular S. A non-finite entry reaches a pivot and fails it.
-    const double largest_diagonal = schur_.diagonal().cwiseAbs().maxCoeff();
     const bool positive_definite = schur_cholesky_.compute(schur_);
     if (positive_definite && schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal) {
       method_ = Method::cholesky;
@@ -798,10 +952,63 @@ class BlockSchurSaddlePoint {
       }
     }
     // Singular: redundant (or, at a dead point, locked) constraints. A rank-revealing QR of S
-    // decides its rank, and its complete orthogonal decomposition gives the minimum-norm y.
+    // decides its rank; the rows it pivots last repeat the others. Those are pinned (Cholesky of
+    // the rest, as fast as a regular S), or, if the rest is not regular either, its complete
+    // orthogonal decomposition gives the minimum-norm y.
     method_ = Method::minimum_norm;
     schur_minimum_norm_.compute(schur_, rank_tolerance);
     rank_deficiency_ = static_cast<int>(m_ - schur_minimum_norm_.rank());
+    const std::vector<int>& order = schur_minimum_norm_.column_order();
+    dense_pinned_.assign(order.begin() + schur_minimum_norm_.rank(), order.end());
+    std::sort(dense_pinned_.begin(), dense_pinned_.end());
+    if (!dense_pinned_.empty() && factorize_dense_pinned(largest_diagonal)) return true;
+    dense_pinned_.clear();
+    return true;
+  }
+
+  /// Redundant constraints on the dense Schur path, at the cost of a regular S. With P the rows
+  /// in dense_pinned_ and K the rest, S_KK is factorized by Cholesky (the pinned rows and
+  /// columns of S cleared but for the diagonal). The rows P repeat K if B_P = C B_K; then
+  /// S_KP = S_KK C^T, and the Schur complement E = S_PP - S_PK C^T vanishes: that is checked
+  /// here (E below detail::repeated_row_tolerance times S's largest diagonal entry), so that a
+  /// row that repeats the others only near a singular configuration goes to the rank-revealing
+  /// path, and one that stops repeating them falls back to the regular paths at once. The columns
+  /// of N = [-C^T; I] span the null space of B^T; a solve's y (y_P = 0) is made the minimum-norm
+  /// one by removing its part in that space, y - N (N^T N)^-1 N^T y, which leaves x unchanged.
+  /// False if the pinned rows do not all repeat the others or the rest is singular.
+  bool factorize_dense_pinned(double largest_diagonal) {
+    const auto k = static_cast<Eigen::Index>(dense_pinned_.size());
+    pinned_schur_ = schur_;
+    pinned_mark_.assign(static_cast<std::size_t>(m_), 0);
+    for (const int row : dense_pinned_) {
+      pinned_mark_[row] = 1;
+      pinned_schur_.row(row).setZero();
+      pinned_schur_.col(row).setZero();
+      pinned_schur_(row, row) = largest_diagonal;
+    }
+    if (!schur_cholesky_.compute(pinned_schur_) ||
+        !(schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal))
+      return false;
+    null_basis_.resize(m_, k);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const int p = dense_pinned_[i];
+      for (int row = 0; row < m_; ++row)  // S_KP's column, from the lower triangle of S
+        null_basis_(row, i) = pinned_mark_[row] ? 0.0 : row > p ? schur_(row, p) : schur_(p, row);
+      schur_cholesky_.solve_in_place(null_basis_.col(i));  // C^T's column
+      double complement = schur_(p, p);                    // E_ii = S_pp - S_pK C^T_i
+      for (int row = 0; row < m_; ++row)
+        if (!pinned_mark_[row])
+          complement -= (row > p ? schur_(row, p) : schur_(p, row)) * null_basis_(row, i);
+      if (!(std::abs(complement) <= detail::repeated_row_tolerance * largest_diagonal))
+        return false;
+      null_basis_.col(i) *= -1.0;
+      null_basis_(p, i) = 1.0;
+    }
+    null_gram_matrix_.noalias() = null_basis_.transpose() * null_basis_;
+    null_gram_.compute(null_gram_matrix_);
+    null_work_.resize(k);
+    method_ = Method::cholesky_pinned;
+    rank_deficiency_ = static_cast<int>(k);
     return true;
   }
 
@@ -833,6 +1040,13 @@ class BlockSchurSaddlePoint {
   SmallCholesky schur_cholesky_;
   PivotedLu schur_lu_;                  // S not positive definite
   RankRevealingQr schur_minimum_norm_;  // S singular
+  std::vector<int> dense_pinned_;       // rows of S that repeat others (cholesky_pinned)
+  Eigen::MatrixXd pinned_schur_;        // S with those rows and columns cleared
+  Eigen::MatrixXd null_basis_;          // (m x k) N, a basis of the null space of B^T
+  Eigen::MatrixXd null_gram_matrix_;    // N^T N
+  Eigen::LLT<Eigen::MatrixXd> null_gram_;  // its factorization
+  Eigen::VectorXd null_work_;              // (k) scratch
+  bool minimum_norm_ = true;               // false within solve_correction
   std::vector<int> pinned_rows_;        // rows of Phi_q that repeat others (sparse_pinned)
   std::vector<double> pinned_values_;   // S's values with those rows and columns cleared
   std::vector<char> pinned_mark_;       // 1 on the pinned rows

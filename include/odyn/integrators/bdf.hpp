@@ -209,10 +209,16 @@ class BdfMethod {
     coordinates_.evaluate_constraints();
   }
 
-  /// In joint coordinates, fills in the workspace at an output as an absolute-coordinate run
-  /// leaves it (see JointCoordinates::complete_workspace).
-  void refresh_blocks() requires requires(Coordinates& c) { c.complete_workspace(); }
-  { coordinates_.complete_workspace(); }
+  /// Before an output: in joint coordinates, fills in the workspace as an absolute-coordinate
+  /// run leaves it (see JointCoordinates::complete_workspace); in absolute ones, makes the
+  /// multipliers of redundant equations minimum-norm (the steps' corrections leave those of
+  /// pinned equations where they were; see AbsoluteCoordinates::make_multipliers_unique).
+  void refresh_blocks() {
+    if constexpr (requires(Coordinates& c) { c.complete_workspace(); })
+      coordinates_.complete_workspace();
+    else
+      coordinates_.make_multipliers_unique(newton, true);
+  }
 
   /// Puts the last attempt's trial state back into the workspace (after interpolate()).
   void restore_trial() {

@@ -273,6 +273,8 @@ class GeneralizedAlphaMethod {
         coordinates_.accelerations() = vdot_n_;  // singular here: the step's own
         coordinates_.multipliers() = lambda_n_;
       }
+    } else {
+      coordinates_.make_multipliers_unique(0, true);  // the step's own: pinned ones unmoved
     }
     if constexpr (requires { coordinates_.complete_workspace(); })
       coordinates_.complete_workspace();
@@ -508,9 +510,10 @@ class GeneralizedAlphaMethod {
       // residual evaluation that would only confirm it. (Phi's contraction slows down from one
       // iterate to the next by up to 7 times on the engine: hence the factor 10.) The element
       // blocks then stay those of the last iterate until refresh_blocks(), which the driver
-      // calls at outputs. Redundant constraints always get the confirming evaluation: their
-      // minimum-norm corrections do not contract as regularly.
-      if (k > 0 && coordinates_.rank_deficiency() == 0) {
+      // calls at outputs. Redundant constraints get the confirming evaluation unless the solver
+      // pinned them (see AbsoluteCoordinates::regular_corrections): minimum-norm corrections
+      // do not contract as regularly.
+      if (k > 0 && coordinates_.regular_corrections()) {
         const double phi_rate = m_ == 0 ? 0.0 : phi_norm / previous_phi_norm;
         if (rate < 0.5 && rate / (1.0 - rate) * norm <= 1.0 && phi_rate < 0.5 &&
             10.0 * phi_rate * phi_norm <= settings_.constraint_tolerance) {

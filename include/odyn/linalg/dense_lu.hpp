@@ -8,6 +8,7 @@
 // the minimum-norm least-squares solution; it is never used on the fast path.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "odyn/linalg/pivoted_lu.hpp"
 #include "odyn/linalg/rank_revealing_qr.hpp"
@@ -40,6 +41,10 @@ class DenseLu {
     cod_.compute(a, threshold);
     return static_cast<int>(a.rows() - cod_.rank());
   }
+
+  /// After factorize_rank_revealing, the columns in pivot order: the last (rank deficiency)
+  /// ones depend on the others.
+  const std::vector<int>& rank_revealing_column_order() const { return cod_.column_order(); }
 
   /// x = A^-1 b (x and b must not alias); the minimum-norm solution after a rank-revealing
   /// factorization.
