@@ -273,10 +273,8 @@ class JointCoordinates {
       tree_solve(false, increment_, motion_);
       closure_rates(motion_, schur_.col(j));
     }
-    if (!pinned_rows_.empty()) {
+    if (!pinned_rows_.empty())  // LLT reads the lower triangle, which this clears
       pin_closure_rows(schur_, 0, schur_.diagonal().cwiseAbs().maxCoeff());
-      schur_.triangularView<Eigen::StrictlyUpper>() = schur_.transpose();
-    }
     schur_llts_[slot_].compute(schur_);
     return schur_llts_[slot_].info() == Eigen::Success;
   }

@@ -144,13 +144,14 @@ class DenseSaddlePoint {
     return true;
   }
 
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  /// `minimum_norm` false: see solve_correction.
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, bool minimum_norm = true) {
     if (!pinned_solve_) return lu_.solve(rhs, solution);
     work_ = rhs;
     for (const int row : pinned_) work_[n_ + row] = 0.0;
     lu_.solve(work_, solution);
     // The minimum-norm multipliers (see factorize_pinned); x is unchanged.
-    if (minimum_norm_)
+    if (minimum_norm)
       detail::remove_null_space_part(null_basis_, null_gram_, null_work_,
                                      solution.tail(work_.size() - n_));
   }
@@ -171,9 +172,7 @@ class DenseSaddlePoint {
   /// so that an iteration never moves the multipliers along the null space of B^T, which turns
   /// with the pose (they would drift along it from step to step).
   void solve_correction(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    minimum_norm_ = false;
-    solve(rhs, solution);
-    minimum_norm_ = true;
+    solve(rhs, solution, false);
   }
 
  private:
@@ -232,7 +231,6 @@ class DenseSaddlePoint {
   DenseLu lu_;
   std::vector<int> pinned_;                // equations that repeat others (see factorize_pinned)
   bool pinned_solve_ = false;              // the last factorization pinned them
-  bool minimum_norm_ = true;               // false within solve_correction
   Eigen::MatrixXd pinned_matrix_;          // matrix_ with their multipliers pinned
   Eigen::MatrixXd null_basis_;             // (m x k) N, a basis of the null space of B^T
   Eigen::MatrixXd null_gram_matrix_;       // N^T N
@@ -467,11 +465,7 @@ class BlockSchurSaddlePoint {
 
   /// solve() for a Newton correction (see DenseSaddlePoint::solve_correction).
   void solve_correction(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    if (path_ == Path::dense_kkt || whole_ == Whole::dense)
-      return dense_.solve_correction(rhs, solution);
-    minimum_norm_ = false;
-    solve(rhs, solution);
-    minimum_norm_ = true;
+    solve(rhs, solution, false);
   }
 
   /// True if the last factorization pinned the multipliers of redundant equations (see
@@ -525,8 +519,10 @@ class BlockSchurSaddlePoint {
   }
 
   /// rhs = [f; g] -> solution = [x; y]: y = S^-1 (B A^-1 f - g), x = A^-1 (f - B^T y).
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-    if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.solve(rhs, solution);
+  /// `minimum_norm` false: see solve_correction.
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, bool minimum_norm = true) {
+    if (path_ == Path::dense_kkt || whole_ == Whole::dense)
+      return dense_.solve(rhs, solution, minimum_norm);
     if (path_ == Path::sparse_kkt || whole_ == Whole::sparse)
       return sparse_kkt_.solve(rhs, solution);
     // B A^-1 f = sum over the blocks of W_e f_b.
@@ -563,7 +559,7 @@ class BlockSchurSaddlePoint {
         for (const int row : dense_pinned_) work_m_[row] = 0.0;
         solution.tail(m_) = work_m_;
         schur_cholesky_.solve_in_place(solution.tail(m_));
-        if (minimum_norm_)
+        if (minimum_norm)
           detail::remove_null_space_part(null_basis_, null_gram_, null_work_, solution.tail(m_));
         break;
       case Method::minimum_norm:
@@ -1046,7 +1042,6 @@ class BlockSchurSaddlePoint {
   Eigen::MatrixXd null_gram_matrix_;    // N^T N
   Eigen::LLT<Eigen::MatrixXd> null_gram_;  // its factorization
   Eigen::VectorXd null_work_;              // (k) scratch
-  bool minimum_norm_ = true;               // false within solve_correction
   std::vector<int> pinned_rows_;        // rows of Phi_q that repeat others (sparse_pinned)
   std::vector<double> pinned_values_;   // S's values with those rows and columns cleared
   std::vector<char> pinned_mark_;       // 1 on the pinned rows
