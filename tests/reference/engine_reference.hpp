@@ -18,6 +18,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "reference/compensated_sum.hpp"
+
 namespace engine_reference {
 
 struct Parameters {
@@ -157,13 +159,6 @@ inline State rk4_increment(const State& y, double h, int stroke, const Parameter
                h / 6 * (k1.omega + 2 * k2.omega + 2 * k3.omega + k4.omega)};
 }
 
-// Kahan summation: with ~1e5 steps, plain rounding of theta ~ 150 (ulp ~ 3e-14) would cost
-// ~1e-9 rad, far more than RK4's truncation error. (Do not compile with -ffast-math.)
-inline void add_compensated(double& sum, double& carry, double x) {
-  const double y = x - carry, s = sum + y;
-  carry = (s - sum) - y;
-  sum = s;
-}
 
 }  // namespace detail
 
@@ -178,8 +173,8 @@ inline std::vector<Sample> solve(double t_end, double dt_out, const Parameters& 
   long long n = static_cast<long long>(std::floor(y.theta / pi));  // current stroke interval
   auto stroke = [&n] { return static_cast<int>(((n % 4) + 4) % 4); };
   auto advance = [&](const State& d) {
-    detail::add_compensated(y.theta, carry.theta, d.theta);
-    detail::add_compensated(y.omega, carry.omega, d.omega);
+    reference::add_compensated(y.theta, carry.theta, d.theta);
+    reference::add_compensated(y.omega, carry.omega, d.omega);
   };
 
   std::vector<Sample> out;
