@@ -213,30 +213,4 @@ inline double arm_angle(const Governor& g, const odyn::Workspace<Model>& ws, int
   return std::atan2(side * d.x(), -d.z());
 }
 
-/// phi' of arm `k`: d_i turns about the hinge axis y with -i phi'.
-inline double arm_rate(const Governor& g, const odyn::Workspace<Model>& ws, int k = 0) {
-  const double side = k == 0 ? 1.0 : -1.0;
-  const auto& spindle = ws.frames[g.spindle.index];
-  const auto& arm = ws.frames[g.arms[k].index];
-  const Vector3d relative = arm.global_angular_velocity() - spindle.global_angular_velocity();
-  return -side * relative.dot(spindle.direction(Vector3d::UnitY()));
-}
-
-/// Sleeve height z_s (the spindle's axis is the global z axis).
-inline double sleeve_z(const Governor& g, const odyn::Workspace<Model>& ws) {
-  return ws.frames[g.sleeve.index].position.z();
-}
-
-/// Spring-damper tension k (length - free) + c length' (N, positive pulls the sleeve down).
-inline double spring_force(const Governor& g, const odyn::Workspace<Model>& ws) {
-  const Parameters& p = g.parameters;
-  const auto& spindle = ws.frames[g.spindle.index];
-  const auto& sleeve = ws.frames[g.sleeve.index];
-  const Vector3d anchor(0.0, 0.0, p.z0);
-  const Vector3d span = sleeve.position - spindle.point(anchor);
-  const double length = span.norm();
-  const double rate = span.dot(sleeve.linear_velocity - spindle.point_velocity(anchor)) / length;
-  return p.stiffness * (length - g.free_length) + p.damping * rate;
-}
-
 }  // namespace governor

@@ -208,6 +208,14 @@ TEST_CASE("bdf held to 0.03 of its tolerance: the achieved error within 10 toler
   // 2714 steps); engine 0.02, 0.95, 0.74, 3.6 (2374 to 20 703 steps); governor (stiff, joint
   // coordinates) 0.007, 0.036, 0.012, 0.044 (116 to 991 steps). With the defaults (the whole
   // tolerance, Newton to 0.1 of it) the first two gave up to 319 and 10.4.
+  // The governor is stiff: linearized at its equilibrium, a fast eigenvalue near -1.4e4 1/s,
+  // 2500 times the slow one, at both ends of its speed ramp.
+  const governor_reference::Parameters parameters;
+  for (const double speed : {parameters.omega0, parameters.omega1}) {
+    const auto modes = governor_reference::modes(speed, parameters);
+    CHECK(modes.fast < -1e4);
+    CHECK(modes.fast / modes.slow > 1e3);
+  }
   for (const double tolerance : {1e-4, 1e-6, 1e-8, 1e-10}) {
     odyn::RunSummary body_run, engine_run, governor_run;
     const double body = torque_free_error(tolerance, body_run);

@@ -69,10 +69,6 @@ struct RunWarning {
 /// simulate_auto).
 inline constexpr long auto_trial_steps = 200;
 
-/// The smallest rtol a run with error control uses (100 machine epsilons, SciPy's floor): a
-/// smaller one only buys more steps whose rounding errors outgrow what they gain.
-inline constexpr double rtol_floor = 100.0 * std::numeric_limits<double>::epsilon();
-
 struct RunSummary {
   IntegratorStatistics statistics;
   AssemblyReport assembly;

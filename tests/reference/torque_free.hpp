@@ -15,7 +15,8 @@
 
 #include <array>
 #include <cmath>
-#include <numbers>
+
+#include "reference/elliptic.hpp"
 
 namespace torque_free {
 
@@ -40,17 +41,6 @@ inline std::array<double, 3> jacobi(double u, double m, double m1) {
   return {sn, cn, std::sqrt(cn * cn + m1 * sn * sn)};  // dn^2 = 1 - m sn^2 without cancellation
 }
 
-/// K(m) from m1 = 1 - m, by the arithmetic-geometric mean.
-inline double complete_k(double m1) {
-  double a = 1.0, b = std::sqrt(m1);
-  for (int i = 0; i < 40 && std::abs(a - b) > 1e-16 * a; ++i) {
-    const double mean = 0.5 * (a + b);
-    b = std::sqrt(a * b);
-    a = mean;
-  }
-  return std::numbers::pi / (2.0 * a);
-}
-
 struct Body {
   double j1 = 1.0, j2 = 2.0, j3 = 3.0;  // kg m^2
   double spin = 10.0, w3 = 5.0;         // omega0 = (0, spin, w3), rad/s, both positive
@@ -61,7 +51,7 @@ struct Body {
   double m1() const { return (j3 - j1) * j3 * w3 * w3 / (l2() - two_e() * j1); }
   double rate() const { return std::sqrt((j3 - j2) * (l2() - two_e() * j1) / (j1 * j2 * j3)); }
   /// The period of omega.
-  double period() const { return 4.0 * complete_k(m1()) / rate(); }
+  double period() const { return 4.0 * reference::elliptic_k_complement(m1()) / rate(); }
 
   /// omega(t) in body axes.
   std::array<double, 3> omega(double t) const {
@@ -69,7 +59,8 @@ struct Body {
     const double a1 = std::sqrt(cross / (j1 * (j3 - j1)));
     const double a2 = std::sqrt(cross / (j2 * (j3 - j2)));
     const double a3 = std::sqrt((l2() - two_e() * j1) / (j3 * (j3 - j1)));
-    const auto [sn, cn, dn] = jacobi(rate() * t + complete_k(m1()), m(), m1());
+    const auto [sn, cn, dn] =
+        jacobi(rate() * t + reference::elliptic_k_complement(m1()), m(), m1());
     return {a1 * cn, a2 * sn, a3 * dn};
   }
 };

@@ -87,7 +87,6 @@ class BdfMethod {
   using Settings = BdfSettings;
   static constexpr int kMaxOrder = 5;
   static constexpr int kHistory = kMaxOrder + 2;  // past values the estimates need
-  static constexpr double kRtolFloor = 100.0 * std::numeric_limits<double>::epsilon();
 
   BdfMethod(const Model& model, Workspace<Model>& ws, Settings settings = {},
             StepControl control = {})
@@ -109,7 +108,7 @@ class BdfMethod {
       throw ModelError("bdf", "local_error_fraction must lie in (0, 1], got " +
                                   to_text(settings.local_error_fraction));
     // The local tolerance: a fraction of the user's, not below what rounding lets a step meet.
-    control_.rtol = std::max(settings.local_error_fraction * control.rtol, kRtolFloor);
+    control_.rtol = std::max(settings.local_error_fraction * control.rtol, rtol_floor);
     control_.atol = settings.local_error_fraction * control.atol;
     rounding_ = 10.0 * std::numeric_limits<double>::epsilon() / control_.rtol;
     if (!(settings.newton_tolerance > 0.0) || !(settings.constraint_tolerance > 0.0) ||
