@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "odyn/analysis/assembly.hpp"
@@ -76,13 +77,14 @@ inline constexpr double near_rank_loss = 1e-4;
 /// the equations pivoted last. Empty otherwise, and for models too large for a dense
 /// factorization at the moment of failure (m^2 n above 1e9: about a thousand equations).
 template <class Model>
-std::string rank_drop(const Model& model, const Workspace<Model>& ws) {
+std::string rank_drop(const Model& model, const Workspace<Model>& ws,
+                      double threshold = near_rank_loss) {
   const int m = model.num_equations(), n = model.num_velocities();
   if (m == 0 || static_cast<double>(m) * m * n > 1e9) return {};  // about a second at most
   const Eigen::MatrixXd transposed = detail::dense_jacobian(model, ws).transpose();
   if (!transposed.allFinite()) return {};
   const RankRevealingQr exact(transposed, rank_tolerance);
-  const RankRevealingQr near(transposed, near_rank_loss);
+  const RankRevealingQr near(transposed, threshold);
   const auto rank = exact.rank(), near_rank = near.rank();
   if (near_rank >= rank) return {};
   std::vector<std::string> joints;
@@ -97,7 +99,7 @@ std::string rank_drop(const Model& model, const Workspace<Model>& ws) {
     names += (i > 0 ? ", '" : "'") + joints[i] + "'";
   if (joints.size() > shown) names += " and " + std::to_string(joints.size() - shown) + " more";
   return " The constraint Jacobian nearly loses rank here: rank " + std::to_string(rank) +
-         " drops to " + std::to_string(near_rank) + " within " + to_text(near_rank_loss) +
+         " drops to " + std::to_string(near_rank) + " within " + to_text(threshold) +
          " of its largest pivot (equations of " + names +
          "): a singular configuration, where the mechanism can move in more ways for an instant "
          "and its branches cross.";
@@ -106,9 +108,10 @@ std::string rank_drop(const Model& model, const Workspace<Model>& ws) {
 /// rank_drop at the state an integrator's coordinates hold; joint coordinates first fill in
 /// every joint's blocks there (complete_workspace), as an absolute-coordinate run leaves them.
 template <class Model, class Coordinates>
-std::string rank_drop(const Model& model, Workspace<Model>& ws, Coordinates& coordinates) {
+std::string rank_drop(const Model& model, Workspace<Model>& ws, Coordinates& coordinates,
+                      double threshold = near_rank_loss) {
   if constexpr (requires { coordinates.complete_workspace(); }) coordinates.complete_workspace();
-  return rank_drop(model, ws);
+  return rank_drop(model, std::as_const(ws), threshold);
 }
 
 }  // namespace odyn::diagnosis

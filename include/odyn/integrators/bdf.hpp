@@ -19,12 +19,12 @@
 // Both factorizations are kept across iterations and steps while Newton converges well and c
 // stays within a band (c enters the right-hand sides, so only the stiff blocks see its change).
 //
-// Error estimate, step and order selection follow DASSL (against a fraction of rtol and atol
-// if settings.local_error_fraction asks: the global error sums the local ones): the local error
-// of order k is
-// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| with y_pred the polynomial extrapolation of
-// the last k+1 values (lambda and mu, of index 3 and 2, stay out of the test); estimates at
-// orders k-1 and k+1 from divided differences choose the order; the step doubles at most and
+// Error estimate, step and order selection follow DASSL, against a fraction of rtol and atol
+// (settings.local_error_fraction: the global error sums the local ones). The local error of
+// order k is (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| with y_pred the polynomial
+// extrapolation of the last k+1 values (lambda and mu, of index 3 and 2, stay out of the test);
+// estimates at orders k-1 and k+1 from the positions' divided differences choose the order
+// (see divided_difference_terms for why not the velocities'); the step doubles at most and
 // shrinks on rejection. A (re)start begins at order 1 with a step from an estimate of y'' and a
 // fictitious past value y_n - h y'_n; order and step then grow every step until the first
 // rejection. Output times inside a step are interpolated by the step's BDF polynomial.
@@ -60,13 +60,13 @@ struct BdfSettings {
 
   /// Each step's local error is held to this fraction of rtol and atol. The global error is
   /// the sum of the local ones, propagated: held to the whole tolerance it came out at up to
-  /// 320 tolerances on a torque-free body, and below 10 at 0.03 with newton_tolerance 0.01. Not
-  /// the default: on a stiff spring 0.03 takes 15 times the steps (docs/integrators.md).
-  double local_error_fraction = 1.0;
+  /// 320 tolerances on a torque-free body; at 0.03 it stays within 10 on that body, the engine
+  /// and a stiff governor from 1e-4 to 1e-10 (docs/integrators.md).
+  double local_error_fraction = 0.03;
   /// Newton stops when the estimated distance to the solution, in units of the local error
   /// tolerance, is below this (DASSL takes 0.33; a corrector stopped early keeps part of the
   /// predictor's error, of one sign step after step)...
-  double newton_tolerance = 0.1;
+  double newton_tolerance = 0.01;
   /// ... and every entry of Phi is below this.
   double constraint_tolerance = 1e-10;
   int max_iterations = 5;
@@ -87,6 +87,11 @@ class BdfMethod {
   using Settings = BdfSettings;
   static constexpr int kMaxOrder = 5;
   static constexpr int kHistory = kMaxOrder + 2;  // past values the estimates need
+  /// The fraction lowers the local rtol to this and no further: the error estimate is a
+  /// difference of values of size |y| through predictor weights that add up to tens, and
+  /// below about 1000 machine epsilons it measures rounding (Andrews' mechanism at rtol 1e-12
+  /// failed with a local rtol of 1e-13 and passed with 2e-13).
+  static constexpr double local_rtol_floor = 1000.0 * std::numeric_limits<double>::epsilon();
 
   BdfMethod(const Model& model, Workspace<Model>& ws, Settings settings = {},
             StepControl control = {})
@@ -108,8 +113,10 @@ class BdfMethod {
       throw ModelError("bdf", "local_error_fraction must lie in (0, 1], got " +
                                   to_text(settings.local_error_fraction));
     // The local tolerance: a fraction of the user's, not below what rounding lets a step meet.
-    control_.rtol = std::max(settings.local_error_fraction * control.rtol, rtol_floor);
-    control_.atol = settings.local_error_fraction * control.atol;
+    // atol follows rtol, so that their ratio stays the user's.
+    control_.rtol = std::max({settings.local_error_fraction * control.rtol,
+                              std::min(control.rtol, local_rtol_floor), rtol_floor});
+    control_.atol = control.atol * std::min(control_.rtol / control.rtol, 1.0);
     rounding_ = 10.0 * std::numeric_limits<double>::epsilon() / control_.rtol;
     if (!(settings.newton_tolerance > 0.0) || !(settings.constraint_tolerance > 0.0) ||
         settings.max_iterations < 1 || !(settings.reuse_band >= 1.0) ||
@@ -123,7 +130,7 @@ class BdfMethod {
     ny_ = nq_total_ + nv_total_;
     const Eigen::Index size = ny_ + m_;  // history values carry lambda for the predictor
     for (auto& y : history_) y = Eigen::VectorXd::Zero(size);
-    for (auto& w : differences_) w = Eigen::VectorXd::Zero(ny_);
+    for (auto& w : differences_) w = Eigen::VectorXd::Zero(nq_total_);
     predicted_ = Eigen::VectorXd::Zero(size);
     beta_ = Eigen::VectorXd::Zero(ny_);
     y_new_ = Eigen::VectorXd::Zero(size);
@@ -252,12 +259,15 @@ class BdfMethod {
     commit();
     failures_ = 0;
     const int k = order_;
-    // Terms ~ |h^(j+1) y^(j+1)| from the divided differences through the new value.
+    // Terms ~ |h^(j+1) q^(j+1)| from the positions' divided differences through the new value,
+    // scaled so that order k's is (k + 1) times the error estimate.
     double term_lower = std::numeric_limits<double>::infinity();
     double term_higher = std::numeric_limits<double>::infinity();
     const bool can_raise = k < settings_.max_order && count_ >= k + 3;
     divided_difference_terms(k, can_raise, term_lower, term_higher);
     const double term = (k + 1) * error_;
+    if (std::isfinite(term_lower)) term_lower *= term;
+    if (std::isfinite(term_higher)) term_higher *= term;
     int new_order = k;
     double estimate = error_;
     if (k > 1 && term_lower <= term && term_lower <= term_higher) {
@@ -508,13 +518,14 @@ class BdfMethod {
 
   /// Weighted RMS size of a correction (c (dv + du) in the tangent coordinates of q, and dv),
   /// in units of the tolerance.
-  double correction_norm() {
+  double correction_norm(const Eigen::VectorXd& dv_step, const Eigen::VectorXd& du_step) {
     coordinates_.error_scale(error_scale_);
     const Eigen::VectorXd& v = coordinates_.velocities();
     double sum = 0.0;
     for (Eigen::Index j = 0; j < nv_total_; ++j) {
-      const double dq = c_ * (dv_[j] + du_[j]) / (control_.atol + control_.rtol * error_scale_[j]);
-      const double dv = dv_[j] / (control_.atol + control_.rtol * std::abs(v[j]));
+      const double dq =
+          c_ * (dv_step[j] + du_step[j]) / (control_.atol + control_.rtol * error_scale_[j]);
+      const double dv = dv_step[j] / (control_.atol + control_.rtol * std::abs(v[j]));
       sum += dq * dq + dv * dv;
     }
     return nv_total_ > 0 ? std::sqrt(sum / static_cast<double>(2 * nv_total_)) : 0.0;
@@ -528,7 +539,8 @@ class BdfMethod {
     set_state(t_new);
     if (!residuals()) return false;
     if (!factorized_ && !factorize()) return false;
-    double first_norm = 0.0;
+    double first_norm = 0.0, last_norm = 0.0;
+    rounding_floor_ = -1.0;
     for (int k = 0; k < settings_.max_iterations; ++k) {
       coordinates_.solve(rhs_, solution_, newton);
       dv_ = solution_.head(nv_total_);
@@ -544,7 +556,7 @@ class BdfMethod {
         du_.setZero();
       }
       ++statistics_.newton_iterations;
-      const double norm = correction_norm();
+      const double norm = correction_norm(dv_, du_);
       coordinates_.velocities() += dv_;
       u_ += du_;
       set_state(t_new);
@@ -555,23 +567,72 @@ class BdfMethod {
       // A correction at the level of rounding says nothing about the rate; near rtol's floor
       // that level is what Newton can reach.
       const bool negligible = norm <= std::max(1e-3 * settings_.newton_tolerance, rounding_);
+      // Corrections that stopped shrinking at the noise a nearly singular matrix makes of
+      // rounding (a singular configuration draws near) are as converged as they can be.
+      const bool stalled = k > 0 && !negligible && norm > 0.5 * last_norm &&
+                           norm <= rounding_floor_factor * rounding_floor();
+      last_norm = norm;
       if (k == 0) {
         first_norm = norm;
-      } else if (!negligible) {
+      } else if (!negligible && !stalled) {
         const double rate = first_norm > 0.0 ? std::pow(norm / first_norm, 1.0 / k) : 0.0;
         if (rate > 0.9) return false;
         rate_factor_ = rate / (1.0 - rate);
       }
-      const bool small =
-          negligible || rate_factor_ * norm <= std::max(settings_.newton_tolerance, rounding_);
+      const bool small = negligible || stalled ||
+                         rate_factor_ * norm <= std::max(settings_.newton_tolerance, rounding_);
       if (small && (m_ == 0 || coordinates_.constraint_values().cwiseAbs().maxCoeff() <=
                                    settings_.constraint_tolerance)) {
-        if (k + 1 > settings_.reuse_iterations) factorized_ = false;
+        if (stalled) ++statistics_.singular_steps;
+        if (k + 1 > settings_.reuse_iterations || stalled) factorized_ = false;
         return true;
       }
     }
     return false;
   }
+
+  /// How small Newton's corrections can get at all, in units of the tolerance: the correction
+  /// that rounding-sized errors of Phi (eps |q|) and of Phi_q v + Phi_t (eps |q| |v|) produce
+  /// through the two factorized matrices. Far below 1 away from singular configurations; near
+  /// one, where Phi_q's smallest singular value sigma nearly vanishes, it grows as 1/sigma (see
+  /// GeneralizedAlphaMethod::rounding_floor). One probe solve each, at most once a step.
+  double rounding_floor() {
+    if (rounding_floor_ >= 0.0) return rounding_floor_;
+    rounding_floor_ = 0.0;
+    if (m_ == 0) return rounding_floor_;
+    constexpr double eps = std::numeric_limits<double>::epsilon();
+    // Phi's terms are about as large as the positions, Phi_q v's as the velocities times the
+    // lever arms, which the positions bound.
+    const double reach = std::max(coordinates_.largest_position(), 1.0);
+    const double position_rounding = eps * reach;
+    const double velocity_rounding =
+        eps * reach * std::max(coordinates_.velocities().cwiseAbs().maxCoeff(), 1.0);
+    // Signs that vary from row to row (Knuth's multiplicative hash), so that the probe has a
+    // part along every direction.
+    const auto sign = [](Eigen::Index i) {
+      return ((static_cast<unsigned>(i) * 2654435761u) & 0x10000u) != 0 ? 1.0 : -1.0;
+    };
+    rhs_.head(nv_total_).setZero();
+    for (Eigen::Index i = 0; i < m_; ++i) rhs_[nv_total_ + i] = sign(i) * velocity_rounding;
+    coordinates_.solve(rhs_, solution_, newton);
+    w_ = solution_.head(nv_total_);
+    for (Eigen::Index i = 0; i < m_; ++i) rhs_[nv_total_ + i] = sign(i) * position_rounding / c_;
+    coordinates_.solve(rhs_, solution_, projection);
+    vdot_probe_ = solution_.head(nv_total_);
+    rounding_floor_ = correction_norm(w_, vdot_probe_);
+    if (!std::isfinite(rounding_floor_)) rounding_floor_ = 0.0;
+    residuals();  // rhs_ back to the state's residual
+    return rounding_floor_;
+  }
+
+  /// The ratio to the largest pivot below which a failure at the noise floor names rank loss.
+  /// The chain of parallelograms at rtol 1e-10 (local rtol 3e-12) fails with pivots within
+  /// 3e-3 of the largest, 3 ms before its singular configuration.
+  static constexpr double noisy_rank_loss = 1e-2;
+
+  /// Corrections up to this multiple of the rounding floor count as noise (a rounding error of
+  /// eps |q| in every entry of Phi is a typical one, not the largest).
+  static constexpr double rounding_floor_factor = 10.0;
 
   /// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| in units of the tolerance.
   void estimate_error() {
@@ -584,23 +645,37 @@ class BdfMethod {
                                              control_.rtol, control_.atol);
   }
 
-  /// After commit: |h^(j+1) (j+1)! [y_{n+1}, ..., y_{n-j}]| for j = k-1 (if k > 1) and k+1
-  /// (if asked), the terms DASSL compares to choose the order.
+  /// After commit: the terms DASSL compares to choose the order, |h^(j+1) (j+1)! [q_{n+1}, ...,
+  /// q_{n-j}]| for j = k-1 (if k > 1) and k+1 (if asked), each divided by order k's. Positions
+  /// alone: where a stiff force holds a motion quasi-static, its velocities are in effect the
+  /// BDF derivative of its positions, whose error (of order h^k) jumps with every change of
+  /// step or order; their differences measure those jumps, not the solution's smoothness, and
+  /// kept a stiff spring at order 1 (995 steps where positions alone take 37).
   void divided_difference_terms(int k, bool higher, double& lower, double& upper) {
-    const int last = std::min(higher ? k + 2 : k, count_ - 1);  // highest difference needed
-    for (int i = 0; i <= last; ++i) differences_[i] = history_[i].head(ny_);
-    double factorial = 1.0, power = 1.0;
+    const int last = std::min(higher ? k + 2 : k + 1, count_ - 1);  // highest difference needed
+    if (last < k + 1) return;  // too short a history to compare
+    for (int i = 0; i <= last; ++i) differences_[i] = history_[i].head(nq_total_);
+    double factorial = 1.0, power = 1.0, same = 0.0;
     for (int l = 1; l <= last; ++l) {
       for (int i = 0; i + l <= last; ++i)
         differences_[i] = (differences_[i] - differences_[i + 1]) / (times_[i] - times_[i + l]);
       factorial *= l;
       power *= h_;
-      const double term = factorial * power *
-                          weighted_rms_norm(differences_[0], history_[0].head(ny_),
-                                            history_[0].head(ny_), control_.rtol, control_.atol);
+      const double term =
+          factorial * power *
+          weighted_rms_norm(differences_[0], history_[0].head(nq_total_),
+                            history_[0].head(nq_total_), control_.rtol, control_.atol);
       if (l == k && k > 1) lower = term;  // difference of order k: the order k-1 term
+      if (l == k + 1) same = term;
       if (l == k + 2 && higher) upper = term;
     }
+    // Positions that did not move say nothing: keep the order.
+    if (!(same > 0.0)) {
+      lower = upper = std::numeric_limits<double>::infinity();
+      return;
+    }
+    lower /= same;
+    upper /= same;
   }
 
   std::string failure_message() {
@@ -608,7 +683,12 @@ class BdfMethod {
       return "bdf: Newton iteration produced a non-finite value; " +
              diagnosis::non_finite_force(model_, ws_) +
              " returned NaN or infinity. Check its parameters and inputs.";
-    const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
+    // Newton's corrections stalled at the noise that rounding makes through a nearly singular
+    // matrix, a hundredth of the tolerance or more (see rounding_floor): the Jacobian is closer
+    // to rank loss than its pivots show at the usual threshold, and rank loss is the cause.
+    const bool noisy = rounding_floor_ >= 0.01;
+    const std::string singular = diagnosis::rank_drop(
+        model_, ws_, coordinates_, noisy ? noisy_rank_loss : diagnosis::near_rank_loss);
     const std::string head =
         "bdf: Newton iteration did not converge in " + std::to_string(settings_.max_iterations) +
         " iterations at order " + std::to_string(order_) + ", step " + to_text(h_) + " s (" +
@@ -636,12 +716,13 @@ class BdfMethod {
   double t_n_ = 0.0, h_ = 0.0, c_ = 1.0, c_factorized_ = 1.0;
   double error_ = 0.0, proposed_step_ = 1e-4, rate_factor_ = 100.0;
   double rounding_ = 0.0;  // a correction's rounding, in units of the local tolerance
+  double rounding_floor_ = -1.0;  // this step's, once measured (see rounding_floor)
   int order_ = 1, count_ = 0, steps_at_order_ = 0, failures_ = 0, hold_ = 0;
   bool factorized_ = false, newton_failed_ = false, starting_ = true;
 
   std::array<Eigen::VectorXd, kHistory> history_;  // (q, v, lambda) at times_, newest first
   std::array<double, kHistory> times_{};
-  std::array<Eigen::VectorXd, kHistory> differences_;  // (q, v) divided differences
+  std::array<Eigen::VectorXd, kHistory> differences_;  // q's divided differences
   Eigen::VectorXd predicted_, beta_, y_new_, scratch_, derivative_, vdot_probe_;
   Eigen::VectorXd u_, dv_, du_;  // u = M^-1 Phi_q^T mu and the corrections
   Eigen::VectorXd w_;            // (scratch) v + u, or a probe's position increment
