@@ -144,6 +144,7 @@ class BdfMethod {
     vdot_probe_ = Eigen::VectorXd::Zero(nv_total_);
     rhs_ = Eigen::VectorXd::Zero(nv_total_ + m_);
     solution_ = rhs_;
+    probe_ = rhs_;  // its velocity part stays zero
     velocity_residual_ = Eigen::VectorXd::Zero(m_);
     q_n_ = coordinates_.positions();
     v_n_ = coordinates_.velocities();
@@ -607,21 +608,17 @@ class BdfMethod {
     const double position_rounding = eps * reach;
     const double velocity_rounding =
         eps * reach * std::max(coordinates_.velocities().cwiseAbs().maxCoeff(), 1.0);
-    // Signs that vary from row to row (Knuth's multiplicative hash), so that the probe has a
-    // part along every direction.
-    const auto sign = [](Eigen::Index i) {
-      return ((static_cast<unsigned>(i) * 2654435761u) & 0x10000u) != 0 ? 1.0 : -1.0;
-    };
-    rhs_.head(nv_total_).setZero();
-    for (Eigen::Index i = 0; i < m_; ++i) rhs_[nv_total_ + i] = sign(i) * velocity_rounding;
-    coordinates_.solve(rhs_, solution_, newton);
+    // solution_ is free here (the next iteration overwrites it); rhs_ is not.
+    for (Eigen::Index i = 0; i < m_; ++i)
+      probe_[nv_total_ + i] = rounding_probe_sign(i) * velocity_rounding;
+    coordinates_.solve(probe_, solution_, newton);
     w_ = solution_.head(nv_total_);
-    for (Eigen::Index i = 0; i < m_; ++i) rhs_[nv_total_ + i] = sign(i) * position_rounding / c_;
-    coordinates_.solve(rhs_, solution_, projection);
+    for (Eigen::Index i = 0; i < m_; ++i)
+      probe_[nv_total_ + i] = rounding_probe_sign(i) * position_rounding / c_;
+    coordinates_.solve(probe_, solution_, projection);
     vdot_probe_ = solution_.head(nv_total_);
     rounding_floor_ = correction_norm(w_, vdot_probe_);
     if (!std::isfinite(rounding_floor_)) rounding_floor_ = 0.0;
-    residuals();  // rhs_ back to the state's residual
     return rounding_floor_;
   }
 
@@ -629,10 +626,6 @@ class BdfMethod {
   /// The chain of parallelograms at rtol 1e-10 (local rtol 3e-12) fails with pivots within
   /// 3e-3 of the largest, 3 ms before its singular configuration.
   static constexpr double noisy_rank_loss = 1e-2;
-
-  /// Corrections up to this multiple of the rounding floor count as noise (a rounding error of
-  /// eps |q| in every entry of Phi is a typical one, not the largest).
-  static constexpr double rounding_floor_factor = 10.0;
 
   /// (h / (t_{n+1} - t_{n-k})) |y_{n+1} - y_pred| in units of the tolerance.
   void estimate_error() {
@@ -728,6 +721,7 @@ class BdfMethod {
   Eigen::VectorXd w_;            // (scratch) v + u, or a probe's increment
   Eigen::VectorXd error_scale_;  // (scratch) see Coordinates::error_scale
   Eigen::VectorXd rhs_, solution_, velocity_residual_;
+  Eigen::VectorXd probe_;  // rounding_floor's right-hand side
   Eigen::VectorXd q_n_, v_n_, vdot_n_, lambda_n_;
   Eigen::VectorXd q_trial_, v_trial_, vdot_trial_, lambda_trial_;  // the last attempt's end
 };

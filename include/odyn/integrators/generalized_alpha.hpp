@@ -565,9 +565,7 @@ class GeneralizedAlphaMethod {
     const double phi_rounding = std::numeric_limits<double>::epsilon() *
                                 std::max(coordinates_.largest_position(), 1.0) / position_factor();
     probe_.head(nv_total_).setZero();
-    for (int i = 0; i < m_; ++i)  // a fixed scramble of signs (Knuth's multiplicative hash)
-      probe_[nv_total_ + i] =
-          ((static_cast<unsigned>(i) * 2654435761u) & 0x10000u) != 0 ? phi_rounding : -phi_rounding;
+    for (int i = 0; i < m_; ++i) probe_[nv_total_ + i] = rounding_probe_sign(i) * phi_rounding;
     coordinates_.solve(probe_, probe_correction_);
     rounding_floor_ =
         velocity_factor() * probe_correction_.head(nv_total_).cwiseAbs().maxCoeff() / tolerance;
@@ -580,10 +578,6 @@ class GeneralizedAlphaMethod {
   bool within_rounding_floor(double norm, double tolerance, int iterate) {
     return norm <= rounding_floor_factor * rounding_floor(tolerance, iterate);
   }
-
-  /// Corrections up to this multiple of the rounding floor count as noise: a rounding error of
-  /// the size eps |q| in every entry of Phi is a typical one, not the largest.
-  static constexpr double rounding_floor_factor = 10.0;
 
   /// How far above constraint_tolerance Phi may stall while the rank is momentarily lower.
   static constexpr double stalled_phi_factor = 100.0;

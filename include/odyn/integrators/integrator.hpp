@@ -30,6 +30,18 @@ namespace odyn {
 /// smaller one only buys more steps whose rounding errors outgrow what they gain.
 inline constexpr double rtol_floor = 100.0 * std::numeric_limits<double>::epsilon();
 
+/// The rounding floor of a Newton iteration near a singular configuration (see
+/// GeneralizedAlphaMethod::rounding_floor, BdfMethod::rounding_floor) is measured by a solve
+/// with a right-hand side of rounding-sized entries; this sign for entry i, a fixed scramble
+/// (Knuth's multiplicative hash), gives that right-hand side a part along every direction.
+inline double rounding_probe_sign(Eigen::Index i) {
+  return ((static_cast<unsigned>(i) * 2654435761u) & 0x10000u) != 0 ? 1.0 : -1.0;
+}
+
+/// Newton corrections up to this multiple of the measured rounding floor count as noise: a
+/// rounding error of eps |q| in every entry of Phi is a typical one, not the largest.
+inline constexpr double rounding_floor_factor = 10.0;
+
 /// Counters every integrator keeps; reported by the analyses and the benchmarks.
 struct IntegratorStatistics {
   long steps = 0;                 // accepted steps
