@@ -28,6 +28,9 @@
 // shrinks on rejection. A (re)start begins at order 1 with a step from an estimate of y'' and a
 // fictitious past value y_n - h y'_n; order and step then grow every step until the first
 // rejection. Output times inside a step are interpolated by the step's BDF polynomial.
+// Near a singular configuration (Phi_q momentarily losing rank) rounding becomes noise above
+// the local tolerance; Newton and the error test allow for the noise they measure there
+// (rounding_floor, estimate_error) instead of shortening the step without end.
 //
 // K. E. Brenan, S. L. Campbell, L. R. Petzold, "Numerical Solution of Initial-Value Problems in
 // Differential-Algebraic Equations", SIAM 1996, Ch. 3 and 5 (DASSL); C. W. Gear, B. Leimkuhler,
@@ -170,6 +173,7 @@ class BdfMethod {
   bool attempt(double h) {
     h_ = h;
     newton_failed_ = true;
+    stalled_step_ = noisy_step_ = false;
     error_ = std::numeric_limits<double>::infinity();
     coefficients(h);
     for (int tries = 0; tries < 2; ++tries) {
@@ -288,7 +292,7 @@ class BdfMethod {
     if (factor >= settings_.max_growth)
       factor = hold_ > 0 ? 1.0 : settings_.max_growth;
     else if (factor <= 1.0)
-      factor = std::clamp(factor, 0.5, 0.9);
+      factor = noisy_step_ ? 1.0 : std::clamp(factor, 0.5, 0.9);  // noise asks for no shorter h
     else
       factor = 1.0;
     if (new_order != k) steps_at_order_ = 0;
@@ -313,9 +317,12 @@ class BdfMethod {
     else if (failures_ > 2)
       order_ = 1;
     if (failures_ >= 2) steps_at_order_ = 0;
+    // Newton failed amid the noise of a singular configuration: a shorter step would end nearer
+    // it, with more noise; a longer one ends beyond it, where Phi_q has its rank back. Once.
+    if (newton_failed_ && failures_ == 1 && noise_above_tolerance(rounding_floor_)) factor = 2.0;
     // No growth for a few steps after a rejection, or h would bounce between the two sizes.
     hold_ = order_ + 1;
-    proposed_step_ = h_ * factor;
+    proposed_step_ = std::min(control_.max_step, h_ * factor);
     if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_))) {
       if (newton_failed_) fail();
       const double t_failed = t_n_ + h_;
@@ -333,6 +340,7 @@ class BdfMethod {
   void commit() {
     coordinates_.make_multipliers_unique(newton);
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
+    if (stalled_step_ || noisy_step_) ++statistics_.singular_steps;
     y_new_ << coordinates_.positions(), coordinates_.velocities(), coordinates_.multipliers();
     push(y_new_, ws_.t);
     t_n_ = ws_.t;
@@ -543,6 +551,7 @@ class BdfMethod {
     double first_norm = 0.0, last_norm = 0.0;
     rounding_floor_ = -1.0;
     for (int k = 0; k < settings_.max_iterations; ++k) {
+      const double residual_before = m_ > 0 ? velocity_residual_.cwiseAbs().maxCoeff() : 0.0;
       coordinates_.solve(rhs_, solution_, newton);
       dv_ = solution_.head(nv_total_);
       coordinates_.multipliers() += solution_.tail(m_) / c_;
@@ -582,9 +591,17 @@ class BdfMethod {
       }
       const bool small = negligible || stalled ||
                          rate_factor_ * norm <= std::max(settings_.newton_tolerance, rounding_);
-      if (small && (m_ == 0 || coordinates_.constraint_values().cwiseAbs().maxCoeff() <=
-                                   settings_.constraint_tolerance)) {
-        if (stalled) ++statistics_.singular_steps;
+      // The rate may be the last step's; the velocity constraints, linear in v but for the
+      // positions' change, must have contracted with it. Near a singular configuration they
+      // did not (the corrections grow as 1/sigma): an iteration more measures the rate anew.
+      const bool contracted =
+          m_ == 0 || negligible || stalled ||
+          velocity_residual_.cwiseAbs().maxCoeff() <=
+              std::max(0.5 * residual_before, residual_rounding * velocity_rounding());
+      if (small && contracted &&
+          (m_ == 0 || coordinates_.constraint_values().cwiseAbs().maxCoeff() <=
+                          settings_.constraint_tolerance)) {
+        stalled_step_ = stalled;
         if (k + 1 > settings_.reuse_iterations || stalled) factorized_ = false;
         return true;
       }
@@ -601,25 +618,55 @@ class BdfMethod {
     if (rounding_floor_ >= 0.0) return rounding_floor_;
     rounding_floor_ = 0.0;
     if (m_ == 0) return rounding_floor_;
-    constexpr double eps = std::numeric_limits<double>::epsilon();
-    // Phi's terms are about as large as the positions, Phi_q v's as the velocities times the
-    // lever arms, which the positions bound.
-    const double reach = std::max(coordinates_.largest_position(), 1.0);
-    const double position_rounding = eps * reach;
-    const double velocity_rounding =
-        eps * reach * std::max(coordinates_.velocities().cwiseAbs().maxCoeff(), 1.0);
+    // Phi's terms are about as large as the positions (see velocity_rounding for Phi_q v's).
+    const double position_rounding =
+        std::numeric_limits<double>::epsilon() * std::max(coordinates_.largest_position(), 1.0);
+    // The residuals a correction leaves count as rounding while within a thousand times that:
+    // a solve through a nearly singular Schur complement leaves more (on the chain of
+    // parallelograms, Phi_q v + Phi_t stayed at 1e-13, 20 times eps |q| |v|).
+    const auto noise = [](double residual, double rounding) {
+      return std::max(rounding, std::min(residual, residual_rounding * rounding));
+    };
+    const double position_noise =
+        noise(coordinates_.constraint_values().cwiseAbs().maxCoeff(), position_rounding);
+    const double velocity_noise =
+        noise(velocity_residual_.cwiseAbs().maxCoeff(), velocity_rounding());
     // solution_ is free here (the next iteration overwrites it); rhs_ is not.
     for (Eigen::Index i = 0; i < m_; ++i)
-      probe_[nv_total_ + i] = rounding_probe_sign(i) * velocity_rounding;
+      probe_[nv_total_ + i] = rounding_probe_sign(i) * velocity_noise;
     coordinates_.solve(probe_, solution_, newton);
     w_ = solution_.head(nv_total_);
     for (Eigen::Index i = 0; i < m_; ++i)
-      probe_[nv_total_ + i] = rounding_probe_sign(i) * position_rounding / c_;
+      probe_[nv_total_ + i] = rounding_probe_sign(i) * position_noise / c_;
     coordinates_.solve(probe_, solution_, projection);
     vdot_probe_ = solution_.head(nv_total_);
     rounding_floor_ = correction_norm(w_, vdot_probe_);
     if (!std::isfinite(rounding_floor_)) rounding_floor_ = 0.0;
     return rounding_floor_;
+  }
+
+  /// Rounding of Phi_q v + Phi_t: eps times the velocities times the lever arms, which the
+  /// positions bound.
+  double velocity_rounding() const {
+    return std::numeric_limits<double>::epsilon() * std::max(coordinates_.largest_position(), 1.0) *
+           std::max(coordinates_.velocities().cwiseAbs().maxCoeff(), 1.0);
+  }
+
+  /// Residuals up to this multiple of their rounding may be rounding too (see rounding_floor).
+  static constexpr double residual_rounding = 1e3;
+
+  /// Near a singular configuration, an error estimate up to this multiple of the rounding floor
+  /// may be noise: |y_{n+1} - y_pred| carries the floor of y_{n+1} and of the k + 1 past values
+  /// through the predictor's weights (their absolute sum is up to 2^(k+1) - 1), times
+  /// h / (t_{n+1} - t_{n-k}), about 1 / (k + 1): up to 11 floors at order 5.
+  static constexpr double noise_allowance = 30.0;
+
+  /// Whether the noise of a rounding floor passes the local tolerance. Not for a local
+  /// tolerance at its own floor (local_rtol_floor): there rounding is near the tolerance
+  /// everywhere, singular or not, and allowing for it cost Andrews' mechanism at 1e-12 a
+  /// factor 13 in accuracy.
+  bool noise_above_tolerance(double floor) const {
+    return control_.rtol > local_rtol_floor && noise_allowance * floor > 1.0;
   }
 
   /// The ratio to the largest pivot below which a failure at the noise floor names rank loss.
@@ -636,6 +683,18 @@ class BdfMethod {
     const double span = ws_.t - times_[k];
     error_ = (h_ / span) * weighted_rms_norm(scratch_, predicted_.head(ny_), y_new_.head(ny_),
                                              control_.rtol, control_.atol);
+    // Near a singular configuration the positions along the momentary extra mobility are fixed
+    // by Phi only to eps |q| / sigma, and rounding alone moves every value by the rounding
+    // floor: the tolerance is raised to that noise for this step (as a tolerance below double
+    // precision is raised to its floor), and the step is not shortened for it: the floor grows
+    // as c shrinks (Phi's rounding / c), and so would the noise. The floor is measured when the
+    // error fails the test, or known already (Newton's corrections stopped shrinking).
+    noisy_step_ = false;
+    if (m_ > 0 && (error_ > 1.0 || rounding_floor_ >= 0.0) &&
+        noise_above_tolerance(rounding_floor())) {
+      error_ /= noise_allowance * rounding_floor_;
+      noisy_step_ = true;
+    }
   }
 
   /// After commit: the terms DASSL compares to choose the order, |h^(j+1) (j+1)! [q_{n+1}, ...,
@@ -712,6 +771,7 @@ class BdfMethod {
   double rounding_floor_ = -1.0;  // this step's, once measured (see rounding_floor)
   int order_ = 1, count_ = 0, steps_at_order_ = 0, failures_ = 0, hold_ = 0;
   bool factorized_ = false, newton_failed_ = false, starting_ = true;
+  bool stalled_step_ = false, noisy_step_ = false;  // the last attempt ended at the noise floor
 
   std::array<Eigen::VectorXd, kHistory> history_;  // (q, v, lambda) at times_, newest first
   std::array<double, kHistory> times_{};

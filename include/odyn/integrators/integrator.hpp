@@ -53,7 +53,8 @@ struct IntegratorStatistics {
   long restarts = 0;              // after discontinuities and at the start
   long events = 0;                // located switches of force laws
   /// Steps whose Newton iteration ended at the rounding floor of a nearly singular constraint
-  /// Jacobian (a singular configuration: see GeneralizedAlphaMethod::rounding_floor).
+  /// Jacobian (a singular configuration: see GeneralizedAlphaMethod::rounding_floor), or, for
+  /// bdf, whose error test allowed for that noise.
   long singular_steps = 0;
   /// Largest local error estimate of an accepted step, in units of the tolerance (rtol, atol);
   /// a fixed-step run reports it too, against the tolerances it was given.
