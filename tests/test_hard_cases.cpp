@@ -4,9 +4,9 @@
 //  - a parallelogram four-bar driven through its change points, against the closed-form motion
 //    of its parallelogram branch, and a driven linkage that locks;
 //  - chains of parallelogram four-bars swinging freely through their singular configurations
-//    (planar and spatial, absolute and joint coordinates), against the minimal-coordinate
-//    pendulum integrated here, and the failure messages of the integrators that do not pass
-//    them yet, with their advice followed;
+//    (planar and spatial, absolute and joint coordinates; generalized-alpha, HHT and bdf),
+//    against the minimal-coordinate pendulum integrated here, and the failure messages where
+//    an integrator does not pass them yet, with their advice followed;
 //  - the heavy top on the rotation group, against an RK4 solution of Euler's equations with a
 //    quaternion written here;
 //  - a stiff spring-mass chain far beyond the explicit stability limit, against its modal
@@ -477,8 +477,8 @@ TEST_CASE("bdf swings the chain of parallelograms through its singular configura
   // Near each crossing the rounding floor of bdf's corrections (what rounding alone makes of
   // them through the nearly singular matrices) passes the local tolerance: corrections at it
   // end the iteration, and the error test allows that noise instead of shortening the step
-  // (which would raise it). The error bound: 300 tolerances (measured up to 108, on 40
-  // four-bars at 1e-6; the propagated error of a periodic motion) plus 1e-7 rad of rounding per
+  // (which would raise it). The error bound: 300 tolerances (measured up to 127, on 40
+  // four-bars at 1e-8; the propagated error of five periods) plus 1e-7 rad of rounding per
   // crossing, as for generalized-alpha.
   const auto check = [](const ChainRun& run, double tolerance, const std::string& what) {
     INFO(what << ", bdf at rtol " << tolerance << ": error " << run.error << " rad, branch "
