@@ -577,6 +577,14 @@ TEST_CASE("Run settings", "[errors]") {
                                                                        [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("generalized-alpha", {"rho_inf"}));
   }
+  SECTION("a model without moving bodies (it used to crash generalized-alpha)") {
+    Model empty;
+    Workspace empty_ws(empty);
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(empty, empty_ws, settings,
+                                                                       [](const Workspace&) {}),
+                           odyn::ModelError,
+                           ModelErrorAbout("dynamics", {"no moving bodies", "add a body"}));
+  }
   SECTION("rho_inf below 0.5 for HHT") {
     settings.integrator = "hht";
     settings.generalized_alpha.rho_inf = 0.3;

@@ -395,6 +395,11 @@ namespace detail {
 template <class Model>
 RunSummary start_run(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
                      AssembledStart<Model>* start) {
+  // Without a moving body there is nothing to integrate (and empty vectors all the way down).
+  if (model.num_bodies() == 0)
+    throw ModelError("dynamics",
+                     "the model has no moving bodies, so there is nothing to simulate; add a "
+                     "body (and the joints and forces that act on it) before running");
   if (!(s.step > 0.0) || !(s.output_interval > 0.0) || !(s.t_end >= ws.t))
     throw ModelError("dynamics",
                      "step and output interval must be positive and t_end >= t0 "

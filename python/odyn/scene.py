@@ -287,6 +287,8 @@ def from_dict(d: Any, where: str = "") -> Scene:
     bodies = d["bodies"]
     if not isinstance(bodies, list):
         fail(f"{prefix}bodies", f"expected a list of bodies, got {type(bodies).__name__}")
+    if not bodies:
+        fail(f"{prefix}bodies", "the list is empty: a model needs at least one moving body")
     for i, b in enumerate(bodies):
         if not isinstance(b, Mapping):
             _not_object(b, f"{prefix}bodies[{i}]")

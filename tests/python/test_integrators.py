@@ -109,6 +109,16 @@ def test_integrator_options_are_checked():
         odyn.simulate(pendulum(), rtol=-1.0)
 
 
+@pytest.mark.parametrize("name", odyn.integrators())
+def test_a_model_without_bodies_is_refused_by_every_integrator(name):
+    # Used to end the process with a segmentation fault (generalized-alpha, hht).
+    planar_gravity_only = odyn.PlanarModel()
+    planar_gravity_only.add_gravity(name="g", acceleration=[0.0, -9.81])
+    for empty in (odyn.Model(), planar_gravity_only):
+        with pytest.raises(odyn.ModelError, match="the model has no moving bodies"):
+            odyn.simulate(empty, t_end=0.01, integrator=name)
+
+
 def engine_with(analysis):
     with open(ENGINE_SCENE) as f:
         d = json.load(f)

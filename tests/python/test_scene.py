@@ -110,6 +110,7 @@ CASES = [
     ("same body twice", ["joints", 1, "body_b"], "crank",
      r"joints\[1\]\.body_b: body_a and body_b are both 'crank'"),
     ("bodies not a list", ["bodies"], {"crank": {}}, r"bodies: expected a list"),
+    ("no bodies", ["bodies"], [], r"bodies: the list is empty: a model needs at least one"),
     ("element not an object", ["forces", 0], 3, r"forces\[0\]: expected an object, got 3"),
     ("physics the library rejects", ["bodies", 0, "inertia"], [1.0, 1.0, 5.0],
      r"bodies\[0\]: crank: principal moments .* violate the triangle inequality"),
