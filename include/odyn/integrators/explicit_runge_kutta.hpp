@@ -14,6 +14,13 @@
 // projection removes the local error's part across the constraints, the error estimate holds
 // the part along them to the tolerance and bounds the part across (see estimate_error).
 //
+// Near a singular configuration (the constraint Jacobian nearly loses rank, the branches of
+// Phi = 0 cross) the index-1 accelerations of a state off the constraints are amplified by
+// about 1/sigma^2 (sigma the Jacobian's smallest singular value): the stages, which lie off
+// them by the stages' own error, then send the step astray or onto the other branch. There the
+// integrator projects every stage onto the constraints first (to rounding), which evaluates
+// the same vector field on the constraint manifold and keeps the order (see project_stage).
+//
 // Step control as in Hairer, Norsett & Wanner, "Solving Ordinary Differential Equations I",
 // Sect. II.4; continuous extensions as in Sect. II.6.
 
@@ -43,6 +50,10 @@ struct DormandPrinceSettings {
   int max_projection_iterations = 6;
   /// The factorization of the saddle-point systems (linalg/linear_solver.hpp).
   LinearSolver linear_solver = LinearSolver::automatic;
+  /// A step rejected far off its target at a state whose constraint Jacobian has pivots this
+  /// far below its largest (a rank-revealing QR, for models of up to m^2 n = 2e7) makes every
+  /// stage be projected onto the constraints, until 8 steps in a row go well. 0: never.
+  double singular_threshold = 0.05;
 };
 
 /// What a method type gives the integrator below, with s = stages (k_0 = f at the committed
@@ -147,11 +158,12 @@ class ExplicitRungeKutta {
   /// enough. False if a stage or the projection failed.
   bool attempt(double h) {
     h_ = h;
+    error_ = std::numeric_limits<double>::infinity();  // until estimated
     dense_ready_ = false;
     for (int i = 1; i < s; ++i) {
       combine(stage_, y_n_, h, Method::a[i], i);
       if (!derivative(t_n_ + Method::c[i] * h, stage_, k_[i])) return false;
-      if (i == stiffness_stage) y_stiffness_ = stage_;
+      if (i == stiffness_stage) y_stiffness_ = project_stages_ ? projected_stage_ : stage_;
     }
     if constexpr (Method::last_stage_is_new_point)
       y_new_ = stage_;
@@ -159,7 +171,7 @@ class ExplicitRungeKutta {
       combine(y_new_, y_n_, h, Method::b, s);
     error_ = estimate_error(h);
     if (!std::isfinite(error_)) return false;
-    if (!project(t_n_ + h, y_new_, held_after_last_stage)) return false;
+    if (!project_or_newton(t_n_ + h, y_new_, held_after_last_stage)) return false;
     // The trial state, kept for restore_trial() and, with k at it, for the dense output.
     coordinates_.read_state(y_trial_);
     // The projection moves the state by about the local error's part across the constraints,
@@ -176,6 +188,19 @@ class ExplicitRungeKutta {
     vdot_trial_ = coordinates_.accelerations();
     lambda_trial_ = coordinates_.multipliers();
     derivative_at_workspace(k_[new_point]);
+    // With projected stages, an error that hardly fell when the step was cut is noise (what
+    // rounding near the configuration leaves), not truncation error, and a shorter step would
+    // not reduce it: allowed up to noise_allowance tolerances, as bdf does.
+    noisy_ = false;
+    if (project_stages_ && rejected_ && h < rejected_step_ && rejected_error_ > 1.0 &&
+        error_ > 1.0 && error_ <= noise_allowance) {
+      const double observed_order =
+          std::log(rejected_error_ / error_) / std::log(rejected_step_ / h);
+      if (observed_order < 0.5 * (Method::error_order + 1)) {
+        noisy_ = true;
+        error_ /= noise_allowance;
+      }
+    }
     return true;
   }
 
@@ -185,7 +210,7 @@ class ExplicitRungeKutta {
   bool interpolate(double t) {
     if (!prepare_dense_output()) return false;
     dense_state(t);
-    return project(t, y_dense_, HeldMatrix::none);
+    return project_or_newton(t, y_dense_, HeldMatrix::none);
   }
 
   /// The interpolated positions and velocities at t and the frames from them, unprojected.
@@ -215,6 +240,12 @@ class ExplicitRungeKutta {
   /// after a rejection.
   void accept() {
     commit();
+    ++steps_since_check_;
+    if (project_stages_) {
+      ++statistics_.singular_steps;
+      // Past the configuration the steps go well again: back to plain stages.
+      if (++calm_steps_ >= calm_steps_to_leave) project_stages_ = false;
+    }
     detect_stiffness();
     statistics_.max_error_estimate = std::max(statistics_.max_error_estimate, error_);
     constexpr double beta = Method::stabilization_exponent;
@@ -225,6 +256,7 @@ class ExplicitRungeKutta {
                           Method::min_step_factor, Method::max_step_factor);
     if (!std::isfinite(factor)) factor = Method::min_step_factor;
     if (rejected_) factor = std::min(factor, 1.0);
+    if (noisy_) factor = std::max(factor, 1.0);  // a shorter step has no less noise
     previous_error_ = std::max(error_, 1e-4);
     rejected_ = false;
     const double grown = h_ * factor;
@@ -237,18 +269,26 @@ class ExplicitRungeKutta {
   void reject() {
     ++statistics_.rejected_steps;
     rejected_ = true;
+    rejected_step_ = h_;
+    rejected_error_ = std::isfinite(error_) ? error_ : 0.0;
     proposed_step_ =
         h_ * std::min(0.9, step_factor(error_, Method::error_order, Method::min_step_factor, 0.9));
     rollback();
+    // A step far off its error target (not the controller's usual overshoot) at a nearly
+    // singular configuration: from now on the stages are projected.
+    if (!(error_ <= suspicious_error)) {
+      if (project_stages_) {
+        calm_steps_ = 0;
+      } else if (steps_since_check_ >= calm_steps_to_leave && near_singular()) {
+        project_stages_ = true;
+        calm_steps_ = 0;
+      }
+    }
     if (proposed_step_ < control_.min_step * std::max(1.0, std::abs(t_n_))) {
       const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
       const std::string head = std::string(Method::name) + ": the step size fell below " +
                                to_text(control_.min_step) + " s";
-      if (!singular.empty())
-        throw SolverError(t_n_, head + "." + singular +
-                                    " Its accelerations are singular there; generalized-alpha "
-                                    "(integrator 'generalized-alpha') steps through such "
-                                    "configurations.");
+      if (!singular.empty()) throw SolverError(t_n_, head + "." + singular + singular_advice);
       throw SolverError(t_n_, head +
                                   "; the problem may be stiff (try bdf or generalized-alpha) "
                                   "or the model singular");
@@ -273,9 +313,13 @@ class ExplicitRungeKutta {
   [[noreturn]] void fail() {
     const double t_failed = t_n_ + h_;
     rollback();
-    throw SolverError(t_failed, std::string(Method::name) +
-                                    ": a stage or the projection onto the constraints failed "
-                                    "(singular mass-constraint matrix or non-finite forces); "
+    const std::string head =
+        std::string(Method::name) + ": a stage or the projection onto the constraints failed";
+    if (const std::string singular = diagnosis::rank_drop(model_, ws_, coordinates_);
+        !singular.empty())
+      throw SolverError(t_failed, head + "." + singular + singular_advice);
+    throw SolverError(t_failed, head +
+                                    " (singular mass-constraint matrix or non-finite forces); "
                                     "check for locked or redundant constraints and the force "
                                     "elements' parameters");
   }
@@ -302,6 +346,17 @@ class ExplicitRungeKutta {
  private:
   static constexpr int s = Method::stages;
   static constexpr double normal_error_allowance = 30.0;
+  static constexpr const char* singular_advice =
+      " Its accelerations are singular there; generalized-alpha (integrator "
+      "'generalized-alpha') steps through such configurations.";
+  /// A rejected step's error beyond this many tolerances asks whether the Jacobian is nearly
+  /// singular (the controller's own misses are a few tolerances).
+  static constexpr double suspicious_error = 10.0;
+  /// Accepted steps without a suspicious rejection that end the projected stages; also the
+  /// fewest accepted steps between two rank checks.
+  static constexpr int calm_steps_to_leave = 8;
+  /// The rank check is a dense QR of Phi_q (m^2 n flops, twice): up to about 10 ms.
+  static constexpr double largest_rank_check = 2e7;
   static constexpr int new_point = s;  // k_[s]: f at the projected end of the last attempt
   static constexpr int num_derivatives = s + 1 + Method::extra_stages;
   // y_{n+1} - y_n, h k_0 - (y_{n+1} - y_n), the Hermite term, then the method's dense rows.
@@ -389,12 +444,70 @@ class ExplicitRungeKutta {
   /// coordinates. False if the saddle-point matrix is singular or a value is not finite.
   bool derivative(double t, const Eigen::VectorXd& y, Eigen::VectorXd& k) {
     ++statistics_.residual_evaluations;
-    coordinates_.load(t, y);
-    coordinates_.evaluate_constraints();
-    if (!accelerations()) return false;
-    coordinates_.position_rate(y, k.head(nq_total_));
+    if (project_stages_ && m_ > 0) {
+      if (!project_stage(t, y)) return false;
+      coordinates_.position_rate(projected_stage_, k.head(nq_total_));
+    } else {
+      coordinates_.load(t, y);
+      coordinates_.evaluate_constraints();
+      if (!accelerations()) return false;
+      coordinates_.position_rate(y, k.head(nq_total_));
+    }
     k.tail(nv_total_) = coordinates_.accelerations();
     return all_finite(k);
+  }
+
+  /// Near a singular configuration: the stage y moved onto Phi = 0 and Phi_q v + Phi_t = 0 (the
+  /// positions by Newton to rounding, not to the projection tolerance: what is left of Phi
+  /// there turns Phi_q's null space by about |Phi| / sigma^2), v' and lambda solved there, and
+  /// the projected stage in projected_stage_. f at the projection of y is a smooth extension of
+  /// the vector field off the constraints that agrees with it on them, so the method keeps its
+  /// order, while the stages no longer see the amplified accelerations off them. False if the
+  /// projection does not converge.
+  bool project_stage(double t, const Eigen::VectorXd& y) {
+    coordinates_.load(t, y);
+    coordinates_.evaluate_constraints();
+    const double rounding =
+        std::numeric_limits<double>::epsilon() * std::max(1.0, coordinates_.largest_position());
+    double residual = coordinates_.position_residual();
+    for (int k = 0; residual > stage_rounding_factor * rounding && k < max_stage_iterations; ++k) {
+      // Newton, not chord: to rounding in few iterations even where sigma is small.
+      if (!factorize()) return false;
+      coordinates_.correct_positions();
+      ++statistics_.newton_iterations;
+      const double before = residual;
+      residual = coordinates_.position_residual();
+      // At rounding, or no longer converging (near a singular configuration Newton converges
+      // only linearly, at about 1/2 a step).
+      if (!(residual < 0.9 * before)) break;
+    }
+    if (!(residual <= settings_.projection_tolerance) || !factorize()) return false;
+    coordinates_.correct_velocities();
+    if (!coordinates_.solve_accelerations()) return false;
+    projected_stage_.resize(size_);
+    coordinates_.read_state(projected_stage_);
+    return true;
+  }
+
+  /// project(), or where its chord iterations do not converge (near a singular configuration,
+  /// where the matrix changes fast with the positions), Newton's (project_stage).
+  bool project_or_newton(double t, const Eigen::VectorXd& y, HeldMatrix held) {
+    return project(t, y, held) || (m_ > 0 && project_stage(t, y));
+  }
+
+  static constexpr double stage_rounding_factor = 10.0;
+  static constexpr double noise_allowance = 30.0;
+  static constexpr int max_stage_iterations = 12;
+
+  /// Whether the constraint Jacobian at the workspace's state nearly loses rank (pivots below
+  /// settings_.singular_threshold of the largest); false for models too large for the dense
+  /// check.
+  bool near_singular() {
+    const double m = static_cast<double>(m_), n = static_cast<double>(nv_total_);
+    if (!(settings_.singular_threshold > 0.0) || m_ == 0 || m * m * n > largest_rank_check)
+      return false;
+    steps_since_check_ = 0;
+    return !diagnosis::rank_drop(model_, ws_, coordinates_, settings_.singular_threshold).empty();
   }
 
   /// The derivative at the trial state (loaded and consistent), whose v' is already solved.
@@ -488,6 +601,13 @@ class ExplicitRungeKutta {
   Eigen::VectorXd y_trial_, vdot_trial_, lambda_trial_, y_dense_;
   std::array<Eigen::VectorXd, num_dense_terms> dense_terms_;
   bool dense_ready_ = false;  // dense_terms_ (and the extra stages) belong to the last attempt
+  bool project_stages_ = false;  // near a singular configuration: see project_stage
+  bool noisy_ = false;           // the last attempt's error was taken for noise
+  double rejected_step_ = 0.0, rejected_error_ = 0.0;  // of the last rejected attempt
+  int calm_steps_ = 0;  // accepted since the last suspicious rejection
+  // Accepted steps since the last rank check (none yet: as if long ago).
+  long steps_since_check_ = calm_steps_to_leave;
+  Eigen::VectorXd projected_stage_;
 };
 
 }  // namespace odyn
