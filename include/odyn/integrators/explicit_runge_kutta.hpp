@@ -124,6 +124,7 @@ class ExplicitRungeKutta {
     y_dense_ = y_n_;
     stage_ = y_n_;
     y_stiffness_ = y_n_;
+    projected_stage_ = y_n_;
     for (auto& k : k_) k = y_n_;
     for (auto& term : dense_terms_) term = y_n_;
     vdot_trial_ = Eigen::VectorXd::Zero(nv_total_);
@@ -188,19 +189,6 @@ class ExplicitRungeKutta {
     vdot_trial_ = coordinates_.accelerations();
     lambda_trial_ = coordinates_.multipliers();
     derivative_at_workspace(k_[new_point]);
-    // With projected stages, an error that hardly fell when the step was cut is noise (what
-    // rounding near the configuration leaves), not truncation error, and a shorter step would
-    // not reduce it: allowed up to noise_allowance tolerances, as bdf does.
-    noisy_ = false;
-    if (project_stages_ && rejected_ && h < rejected_step_ && rejected_error_ > 1.0 &&
-        error_ > 1.0 && error_ <= noise_allowance) {
-      const double observed_order =
-          std::log(rejected_error_ / error_) / std::log(rejected_step_ / h);
-      if (observed_order < 0.5 * (Method::error_order + 1)) {
-        noisy_ = true;
-        error_ /= noise_allowance;
-      }
-    }
     return true;
   }
 
@@ -256,7 +244,6 @@ class ExplicitRungeKutta {
                           Method::min_step_factor, Method::max_step_factor);
     if (!std::isfinite(factor)) factor = Method::min_step_factor;
     if (rejected_) factor = std::min(factor, 1.0);
-    if (noisy_) factor = std::max(factor, 1.0);  // a shorter step has no less noise
     previous_error_ = std::max(error_, 1e-4);
     rejected_ = false;
     const double grown = h_ * factor;
@@ -269,8 +256,6 @@ class ExplicitRungeKutta {
   void reject() {
     ++statistics_.rejected_steps;
     rejected_ = true;
-    rejected_step_ = h_;
-    rejected_error_ = std::isfinite(error_) ? error_ : 0.0;
     proposed_step_ =
         h_ * std::min(0.9, step_factor(error_, Method::error_order, Method::min_step_factor, 0.9));
     rollback();
@@ -484,7 +469,6 @@ class ExplicitRungeKutta {
     if (!(residual <= settings_.projection_tolerance) || !factorize()) return false;
     coordinates_.correct_velocities();
     if (!coordinates_.solve_accelerations()) return false;
-    projected_stage_.resize(size_);
     coordinates_.read_state(projected_stage_);
     return true;
   }
@@ -496,7 +480,6 @@ class ExplicitRungeKutta {
   }
 
   static constexpr double stage_rounding_factor = 10.0;
-  static constexpr double noise_allowance = 30.0;
   static constexpr int max_stage_iterations = 12;
 
   /// Whether the constraint Jacobian at the workspace's state nearly loses rank (pivots below
@@ -602,8 +585,6 @@ class ExplicitRungeKutta {
   std::array<Eigen::VectorXd, num_dense_terms> dense_terms_;
   bool dense_ready_ = false;  // dense_terms_ (and the extra stages) belong to the last attempt
   bool project_stages_ = false;  // near a singular configuration: see project_stage
-  bool noisy_ = false;           // the last attempt's error was taken for noise
-  double rejected_step_ = 0.0, rejected_error_ = 0.0;  // of the last rejected attempt
   int calm_steps_ = 0;  // accepted since the last suspicious rejection
   // Accepted steps since the last rank check (none yet: as if long ago).
   long steps_since_check_ = calm_steps_to_leave;
