@@ -82,6 +82,15 @@ class AbsoluteCoordinates {
   void evaluate_constraints() { odyn::evaluate_constraints(model_, ws_); }
   void evaluate_forces() { odyn::evaluate_forces(model_, ws_); }
   bool factorize() { return solvers_[0].factorize(model_, ws_, IterationFactors{}); }
+  /// The last factorization's smallest pivot relative to the diagonal of the Schur complement
+  /// (see BlockSchurSaddlePoint::pivot_ratio): small near a singular configuration. 1 for a
+  /// solver that does not tell.
+  double pivot_ratio() const {
+    if constexpr (requires(const Solver& solver) { solver.pivot_ratio(); })
+      return solvers_[0].pivot_ratio();
+    else
+      return 1.0;
+  }
   /// v' and lambda at the loaded state with the matrix factorized last (in that slot).
   bool solve_accelerations(int slot = 0) {
     return projection_.solve_accelerations(model_, ws_, solvers_[slot]);

@@ -447,6 +447,26 @@ class BlockSchurSaddlePoint {
     return path_ == Path::sparse_schur ? factorize_sparse_schur(model, ws) : factorize_schur();
   }
 
+  /// The smallest pivot of the last Cholesky factorization of S relative to S's diagonal (the
+  /// dense path: to its largest entry; the sparse one: each to its own). Near a singular
+  /// configuration it falls as sigma^2, sigma the smallest singular value of Phi_q relative to
+  /// its scale. 1 where the last factorization was another (rows pinned, the whole matrix, no
+  /// equations), 0 where S was found singular and solved by minimum norm.
+  double pivot_ratio() const {
+    if (path_ == Path::dense_kkt || path_ == Path::sparse_kkt || whole_ != Whole::none || m_ == 0)
+      return 1.0;
+    switch (method_) {
+      case Method::cholesky:
+        return pivot_ratio_;
+      case Method::sparse_cholesky:
+        return sparse_cholesky_.smallest_pivot_ratio();
+      case Method::minimum_norm:
+        return 0.0;
+      default:
+        return 1.0;
+    }
+  }
+
   /// Number of dependent constraint equations in the last factorized matrix (0: full rank).
   int rank_deficiency() const {
     if (path_ == Path::dense_kkt || whole_ == Whole::dense) return dense_.rank_deficiency();
@@ -935,6 +955,7 @@ class BlockSchurSaddlePoint {
     const bool positive_definite = schur_cholesky_.compute(schur_);
     if (positive_definite && schur_cholesky_.smallest_pivot() > rank_tolerance * largest_diagonal) {
       method_ = Method::cholesky;
+      pivot_ratio_ = schur_cholesky_.smallest_pivot() / largest_diagonal;
       return true;
     }
     if (!schur_.allFinite()) return false;
@@ -1050,6 +1071,7 @@ class BlockSchurSaddlePoint {
   bool pins_doubted_ = false;           // a solve found a pinned row inconsistent
   long pin_decisions_ = 0;              // rank passes that decided them
   double trusted_pivot_ratio_ = singular_pivot_ratio;  // see trust_pivots
+  double pivot_ratio_ = 1.0;  // of the last dense Cholesky of S (see pivot_ratio)
   detail::RowOrder row_order_;                         // how to find them (built on the first need)
   Eigen::VectorXd work_m_, work_y_, work_qr_;
 };

@@ -13,6 +13,11 @@
 // a switch. v' and lambda come from [M Phi_q^T; Phi_q 0] [v'; lambda] = [Q; gamma] at the
 // projected state. The local error is estimated by the difference of the orders k + 1 and k.
 //
+// Near a singular configuration (Phi_q nearly loses rank, which the step's factorization tells
+// by its smallest pivot) the positions are projected to rounding by Newton first: there what
+// a projection to its tolerance leaves of Phi is amplified into v', and from v' into the next
+// k steps (docs/hard-cases.md, "Singular configurations").
+//
 // After a restart (the start, a switch of a force law) the history is gone: the first k - 1
 // steps are taken by the Dormand-Prince 5(4) method on the same steps (about 7 evaluations
 // each), whose error is of the size of the multistep method's or below it for k <= 6.
@@ -26,6 +31,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "odyn/analysis/absolute_coordinates.hpp"
@@ -289,9 +295,20 @@ class Adams {
     coordinates_.evaluate_constraints();
     if (!factorize()) return false;
     bool moved = false;
-    for (int k = 0; m_ > 0 && !(coordinates_.position_residual() <= settings_.projection_tolerance);
+    if (near_singular()) {
+      if (!project_to_rounding()) return false;
+      moved = true;
+    }
+    for (int k = 0;
+         !moved && m_ > 0 && !(coordinates_.position_residual() <= settings_.projection_tolerance);
          ++k) {
-      if (k == settings_.max_projection_iterations) return false;
+      if (k == settings_.max_projection_iterations) {
+        // Chord iterations that do not converge: the matrix changes fast with the positions,
+        // as near a singular configuration. Newton's, from where they got to.
+        ++statistics_.singular_steps;
+        if (!factorize() || !project_to_rounding()) return false;
+        break;
+      }
       coordinates_.correct_positions();
       ++statistics_.newton_iterations;
       moved = true;
@@ -309,6 +326,47 @@ class Adams {
     ++statistics_.factorizations;
     return coordinates_.factorize();
   }
+
+  /// Whether the factorization just made says that Phi_q nearly loses rank (a singular
+  /// configuration). What the projection leaves of Phi there turns Phi_q's null space by
+  /// about |Phi| / sigma^2, and v' with it: at the projection tolerance, 1e-11, the history
+  /// of derivatives took errors that put 10 parallelogram four-bars 0.15 rad off after 20
+  /// crossings at h = 1e-4 s, without a warning.
+  bool near_singular() {
+    if constexpr (requires { coordinates_.pivot_ratio(); }) {
+      if (m_ > 0 && coordinates_.pivot_ratio() < singular_pivot_ratio) {
+        ++statistics_.singular_steps;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Newton (refactorizing) on the positions to rounding, 10 eps |q|, or until an iteration
+  /// gains less than 10 % (near the configuration Newton converges only linearly), from the
+  /// factorization at the loaded positions. False if a factorization fails or Phi is still
+  /// above 100 projection tolerances (with redundant constraints near the configuration,
+  /// Newton stalls at about 2 of them). The caller factorizes at the new positions.
+  bool project_to_rounding() {
+    const double rounding = 10.0 * std::numeric_limits<double>::epsilon() *
+                            std::max(1.0, coordinates_.largest_position());
+    double residual = coordinates_.position_residual();
+    for (int k = 0; residual > rounding && k < max_rounding_iterations; ++k) {
+      if (k > 0 && !factorize()) return false;
+      coordinates_.correct_positions();
+      ++statistics_.newton_iterations;
+      const double before = residual;
+      residual = coordinates_.position_residual();
+      if (!(residual < 0.9 * before)) break;
+    }
+    return residual <= singular_residual_allowance * settings_.projection_tolerance;
+  }
+
+  /// Below this pivot ratio of the Schur complement (see BlockSchurSaddlePoint::pivot_ratio;
+  /// about sigma^2) the positions are projected to rounding.
+  static constexpr double singular_pivot_ratio = 1e-4;
+  static constexpr int max_rounding_iterations = 12;
+  static constexpr double singular_residual_allowance = 100.0;
 
   const Model& model_;
   Workspace<Model>& ws_;
