@@ -295,12 +295,13 @@ class Adams {
     coordinates_.evaluate_constraints();
     if (!factorize()) return false;
     bool moved = false;
-    if (near_singular()) {
+    const bool rounded = near_singular();  // then Newton's, to rounding, instead of the chord
+    if (rounded) {
       if (!project_to_rounding()) return false;
       moved = true;
     }
-    for (int k = 0;
-         !moved && m_ > 0 && !(coordinates_.position_residual() <= settings_.projection_tolerance);
+    for (int k = 0; !rounded && m_ > 0 &&
+                    !(coordinates_.position_residual() <= settings_.projection_tolerance);
          ++k) {
       if (k == settings_.max_projection_iterations) {
         // Chord iterations that do not converge: the matrix changes fast with the positions,
