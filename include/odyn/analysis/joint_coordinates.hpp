@@ -64,6 +64,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <type_traits>
@@ -564,6 +565,33 @@ class JointCoordinates {
               node.screws[k].kind == Screw::Kind::rotation ? 1.0 : std::abs(q_[node.q_offset + k]);
       }
     }
+  }
+
+  /// The smallest pivot of the closures' Schur complement S = C A^-1 C^T in the last
+  /// factorization, relative to S's largest diagonal entry: about sigma^2 of C's rows, small
+  /// near a singular configuration (as AbsoluteCoordinates::pivot_ratio). Pinned rows left
+  /// out; 1 without closures.
+  double pivot_ratio() const {
+    double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
+    const auto pinned = [&](int row) {
+      return std::binary_search(pinned_rows_.begin(), pinned_rows_.end(), row);
+    };
+    const int m = static_cast<int>(num_equations());
+    for (int i = 0; i < m; ++i) {
+      if (pinned(i)) continue;
+      double pivot, diagonal;
+      if (dense_) {
+        pivot = kkt_ldlts_[slot_].schur_pivot(i);
+        diagonal = kkt_ldlts_[slot_].schur_diagonal(i);
+      } else {  // S = L L^T: the pivot L(i, i)^2, the diagonal the squared norm of L's row
+        const auto row = schur_llts_[slot_].matrixLLT().row(i).head(i + 1);
+        pivot = row[i] * row[i];
+        diagonal = row.squaredNorm();
+      }
+      smallest = std::min(smallest, pivot);
+      largest = std::max(largest, diagonal);
+    }
+    return largest > 0.0 ? smallest / largest : 1.0;
   }
 
   /// The largest coordinate of a body's position: the rounding in Phi scales with it.

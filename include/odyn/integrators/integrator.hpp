@@ -56,7 +56,8 @@ struct IntegratorStatistics {
   /// Jacobian (a singular configuration: see GeneralizedAlphaMethod::rounding_floor), or, for
   /// bdf, whose error test allowed for that noise; for dopri5 and dop853, steps whose stages
   /// were projected onto the constraints there (ExplicitRungeKutta::project_stage); for adams,
-  /// steps whose positions were projected to rounding there (Adams::project_to_rounding).
+  /// steps whose positions (and velocities) were projected to rounding there
+  /// (Adams::project_to_rounding).
   long singular_steps = 0;
   /// Largest local error estimate of an accepted step, in units of the tolerance (rtol, atol);
   /// a fixed-step run reports it too, against the tolerances it was given.

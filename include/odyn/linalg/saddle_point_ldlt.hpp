@@ -130,6 +130,20 @@ class SaddlePointLdlt {
     solve_(size_, lower_.data(), inverse_diagonal_.data(), x.data());
   }
 
+  /// The pivot of constraint row i (i < m) in the last factorization: minus the i-th pivot of
+  /// the Schur complement S = B A^-1 B^T in its own L D L^T. A small one (relative to
+  /// schur_diagonal) says that B's rows nearly depend on each other.
+  double schur_pivot(int i) const { return -lower_(n_ + i, n_ + i); }
+
+  /// S(i, i), from the factors: the i-th pivot of S plus what the rows before it took from it,
+  /// sum over k < i of L(i, k)^2 D(k). O(i).
+  double schur_diagonal(int i) const {
+    const int row = n_ + i;
+    double diagonal = lower_(row, row);
+    for (int k = n_; k < row; ++k) diagonal += lower_(row, k) * lower_(row, k) * lower_(k, k);
+    return -diagonal;
+  }
+
  private:
   using Factor = detail::SaddlePointLdltFactor;
   using Solve = detail::SaddlePointLdltSolve;
