@@ -7,6 +7,7 @@
 // Phi_q x, Phi_q^T y), which share no code with the factorizations.
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -207,6 +208,14 @@ TEST_CASE("Saddle-point L D L^T solves with a known solution at every size, unro
       REQUIRE(ldlt.compute(k));
       ldlt.solve_in_place(x);
       CHECK((x - expected).lpNorm<Eigen::Infinity>() < 1e-10);
+      // The Schur complement's pivots and diagonal, against S = B A^-1 B^T formed here and
+      // its Cholesky factor (pivot i = L(i, i)^2).
+      const Eigen::MatrixXd schur = b * a.llt().solve(b.transpose());
+      const Eigen::MatrixXd lower = schur.llt().matrixL();
+      for (int i = 0; i < static_cast<int>(m); ++i) {
+        CHECK(std::abs(ldlt.schur_pivot(i) - lower(i, i) * lower(i, i)) <= 1e-10 * schur(i, i));
+        CHECK(std::abs(ldlt.schur_diagonal(i) - schur(i, i)) <= 1e-10 * schur(i, i));
+      }
     }
   }
   // A singular A (a zero row and column) or repeated rows of B give a pivot of the wrong sign.
