@@ -610,8 +610,11 @@ TEST_CASE("adams swings the chain of parallelograms through its singular configu
     const std::string name = "planar, " + std::to_string(n) + " four-bars";
     for (const double step : steps) {
       check(run_chain<odyn::AdamsBashforth>(chain, p, "adams", step, chain_t_end), step, name);
-      check(run_chain<odyn::JointAdamsBashforth>(chain, p, "adams", step, chain_t_end), step,
-            name + ", joint coordinates");
+      // In joint coordinates 40 four-bars cost O(N m) per factorization (80 closure equations;
+      // 17 s at 1e-4 s in a Release build): at 4e-4 s only, where it was 1.3e-5 rad off before.
+      if (n < 40 || step == 4e-4)
+        check(run_chain<odyn::JointAdamsBashforth>(chain, p, "adams", step, chain_t_end), step,
+              name + ", joint coordinates");
     }
   }
   pc::Parameters p;
