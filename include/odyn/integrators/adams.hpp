@@ -370,7 +370,7 @@ class Adams {
   }
 
   /// Below this pivot ratio of the Schur complement (see BlockSchurSaddlePoint::pivot_ratio and
-  /// JointCoordinates::pivot_ratio; about sigma^2) the positions are projected to rounding.
+  /// JointCoordinates::pivot_ratio; about sigma^2) positions and velocities go to rounding.
   static constexpr double singular_pivot_ratio = 1e-4;
   static constexpr int max_rounding_iterations = 12;
   static constexpr double singular_residual_allowance = 100.0;

@@ -130,8 +130,8 @@ class SaddlePointLdlt {
     solve_(size_, lower_.data(), inverse_diagonal_.data(), x.data());
   }
 
-  /// The pivot of constraint row i (i < m) in the last factorization: minus the i-th pivot of
-  /// the Schur complement S = B A^-1 B^T in its own L D L^T. A small one (relative to
+  /// The i-th pivot (i < m) of the Schur complement S = B A^-1 B^T in its own L D L^T: minus
+  /// constraint row i's pivot in the last factorization. A small one (relative to
   /// schur_diagonal) says that B's rows nearly depend on each other.
   double schur_pivot(int i) const { return -lower_(n_ + i, n_ + i); }
 
