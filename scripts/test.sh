@@ -78,6 +78,9 @@ section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
   ctest --test-dir build-asan --output-on-failure
 )
+# The sanitizer run is the longest step of CI: name the cases that cost it most.
+echo "Slowest cases under the sanitizers (seconds):"
+grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log | sort -rn | head -n 12 || true
 
 section "Release examples, install + downstream find_package(odyn)"
 finish "$release_pid" "$release_log" "the Release examples or the downstream build"
