@@ -98,9 +98,11 @@ std::vector<Setting> standard_ladder(const std::vector<double>& steps, bool quic
     for (double h : steps) ladder.push_back({"adams 6, fixed h", "adams", false, 2.0 * h});
   for (double tol : loose)
     ladder.push_back({"generalized-alpha, adaptive", "generalized-alpha", true, tol});
+  // auto runs with the defaults, its coordinates "auto" too; the others in absolute ones.
   for (const std::string name : {"dopri5", "dop853", "bdf", "auto"})
     if (known_integrator(name))
-      for (double tol : tight) ladder.push_back({name, name, true, tol});
+      for (double tol : tight)
+        ladder.push_back({name, name, true, tol, 0.9, 6, name == "auto" ? "auto" : "absolute"});
   if (joint_coordinates) {  // the same methods on a spanning tree's joint coordinates
     for (double h : steps)
       ladder.push_back({"generalized-alpha, fixed h, joint coordinates", "generalized-alpha", false,

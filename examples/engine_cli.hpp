@@ -3,7 +3,7 @@
 // `slider_crank_planar`): options, the CSV of the paper's outputs and the summary.
 //
 //   NAME [--h STEP] [--t-end T] [--dt-out DT] [--out FILE] [--integrator NAME] [--rho-inf R]
-//        [--order K] [--rtol R] [--atol A] [--coordinates absolute|joint]
+//        [--order K] [--rtol R] [--atol A] [--coordinates auto|absolute|joint]
 
 #include <cstdio>
 #include <cstdlib>
@@ -39,7 +39,7 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
               << " [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]\n"
                  "       [--integrator generalized-alpha|hht|auto|dopri5|dop853|bdf|adams]\n"
                  "       [--rho-inf R] [--order K (adams, 1 to 6)] [--rtol R] [--atol A]\n"
-                 "       [--coordinates absolute|joint]\n"
+                 "       [--coordinates auto|absolute|joint]\n"
                  "(with --rtol/--atol, error control: --h is then the first step)\n";
   };
   bool tolerance_given = false;  // --rtol/--atol: generalized-alpha and hht then adapt h
@@ -107,7 +107,9 @@ int run_command_line(const std::string& program, Build build, int argc, char** a
       std::printf("  %s\n", summary.integrator_choice.c_str());
     std::printf("  %d coordinates, %d constraint equations in absolute coordinates%s\n",
                 e.model.num_velocities(), e.model.num_equations(),
-                settings.coordinates == "joint" ? "; stepped in joint coordinates" : "");
+                summary.coordinates == "joint" ? "; stepped in joint coordinates" : "");
+    if (!summary.coordinates_choice.empty())
+      std::printf("  %s\n", summary.coordinates_choice.c_str());
     std::printf("  steps %ld, Newton iterations %ld (%.2f per step), factorizations %ld\n",
                 stats.steps, stats.newton_iterations,
                 stats.steps ? double(stats.newton_iterations) / double(stats.steps) : 0.0,

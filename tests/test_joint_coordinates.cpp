@@ -26,6 +26,7 @@
 
 #include "bricard_model.hpp"
 #include "engine_model.hpp"
+#include "parallelogram_chain_model.hpp"
 #include "reference/engine_reference.hpp"
 #include "reference/steady_top.hpp"
 #include "rope_model.hpp"
@@ -744,6 +745,94 @@ TEST_CASE("Joint coordinates: unknown coordinates refused", "[joint][errors]") {
   unknown.coordinates = "relative";
   CHECK_THROWS_WITH(odyn::simulate(e.model, engine_ws, unknown, [](const auto&) {}),
                     Catch::Contains("unknown coordinates 'relative'"));
+}
+
+TEST_CASE("Coordinates auto: joint ones for the engine, absolute ones where they would not pay",
+          "[joint][auto]") {
+  using Catch::Contains;
+  SECTION("the engine with the defaults: joint coordinates, the same answer as absolute ones") {
+    const auto reference = engine_reference::solve(1.0, 1e-3);
+    engine::Engine e = engine::build();
+    odyn::AssembledStart<engine::Model> start;
+    const auto run = [&](const char* coordinates, odyn::AssembledStart<engine::Model>* kept) {
+      odyn::Workspace<engine::Model> ws(e.model);
+      odyn::DynamicsSettings settings;  // integrator and coordinates "auto"
+      settings.coordinates = coordinates;
+      settings.rtol = settings.atol = 1e-8;
+      const auto summary = odyn::simulate(e.model, ws, settings, [](const auto&) {}, kept);
+      return std::tuple(summary, engine::crank_angle(e, ws));
+    };
+    CHECK(odyn::DynamicsSettings{}.coordinates == "auto");
+    const auto [chosen, theta] = run("auto", &start);
+    const auto [absolute, theta_absolute] = run("absolute", nullptr);
+    INFO(chosen.coordinates_choice << "; theta(1) errors " << theta - reference.back().theta
+                                   << " (auto), " << theta_absolute - reference.back().theta
+                                   << " (absolute)");
+    CHECK(chosen.coordinates == "joint");
+    CHECK_THAT(chosen.coordinates_choice, Contains("3 closure equations"));
+    CHECK(chosen.integrator == "dop853");
+    CHECK(absolute.coordinates == "absolute");
+    CHECK(absolute.coordinates_choice.empty());
+    // Measured: 3e-8 rad (auto, joint coordinates) and 2.6e-7 rad (absolute).
+    CHECK(std::abs(theta - reference.back().theta) < 1e-6);
+    CHECK(std::abs(theta_absolute - reference.back().theta) < 1e-6);
+    // The choice assembles first; the run counts that assembly as its own, and a second run
+    // from the kept start reuses it.
+    CHECK_FALSE(chosen.assembly_reused);
+    CHECK(chosen.setup_seconds > 0.0);
+    const auto [again, theta_again] = run("auto", &start);
+    CHECK(again.assembly_reused);
+    CHECK(again.coordinates == "joint");
+    CHECK(theta_again == theta);
+  }
+  SECTION("absolute coordinates: planar, implicit, redundant, springs between bodies, loops") {
+    const auto choice = [](const auto& model, const char* integrator) {
+      using Model = std::remove_cvref_t<decltype(model)>;
+      odyn::Workspace<Model> ws(model);
+      odyn::DynamicsSettings settings;
+      settings.integrator = integrator;
+      settings.t_end = 1e-3;
+      const auto summary = odyn::simulate(model, ws, settings, [](const auto&) {});
+      return summary.coordinates + ": " + summary.coordinates_choice;
+    };
+    CHECK_THAT(choice(engine::planar::build().model, "auto"),
+               Contains("absolute: ") && Contains("planar"));
+    CHECK_THAT(choice(engine::build().model, "generalized-alpha"),
+               Contains("absolute: ") && Contains("implicit"));
+    CHECK_THAT(choice(engine::build().model, "adams"), Contains("joint: "));
+    // Bricard's linkage: one redundant equation, minimum-norm in absolute coordinates.
+    CHECK_THAT(choice(bricard::build().model, "auto"),
+               Contains("absolute: ") && Contains("1 redundant"));
+    // Springs between moving links: absolute for auto (it may turn to bdf), joint for dop853.
+    const RopeModel springs =
+        rope(6, 0.1, sp::Tsda::Parameters{.stiffness = 40.0, .damping = 0.5, .free_length = 0.9});
+    CHECK_THAT(choice(springs, "auto"),
+               Contains("absolute: ") && Contains("joins two moving bodies"));
+    CHECK_THAT(choice(springs, "dop853"), Contains("joint: ") && Contains("0 closure"));
+    // Ten spatial four-bars leave 50 closure equations (the rule's own limit, whatever the
+    // redundancy that the run finds at its start).
+    parallelogram_chain::Parameters ten;
+    ten.four_bars = 10;
+    const auto chain = parallelogram_chain::spatial::build(ten);
+    using ChainModel = std::remove_cvref_t<decltype(chain.model)>;
+    CHECK(odyn::JointCoordinates<ChainModel>::closure_equations(chain.model) == 50);
+    odyn::DynamicsSettings settings;
+    const odyn::CoordinatesChoice loops = odyn::choose_coordinates(chain.model, settings, {});
+    CHECK(loops.coordinates == "absolute");
+    CHECK_THAT(loops.reason, Contains("50 closure equations"));
+    ten.four_bars = 2;
+    const auto two = parallelogram_chain::spatial::build(ten);
+    CHECK(odyn::choose_coordinates(two.model, settings, {}).coordinates == "joint");
+    CHECK_THAT(choice(two.model, "auto"), Contains("absolute: ") && Contains("redundant"));
+  }
+  SECTION("the count of closure equations is the tree's") {
+    engine::Engine e = engine::build();
+    odyn::Workspace<engine::Model> ws(e.model);
+    odyn::assemble(e.model, ws);
+    const odyn::JointCoordinates<engine::Model> coordinates(e.model, ws);
+    CHECK(odyn::JointCoordinates<engine::Model>::closure_equations(e.model) ==
+          coordinates.num_equations());
+  }
 }
 
 // ---- Planar models: the same tree in the plane (3 numbers per motion, see tree_algebra.hpp).

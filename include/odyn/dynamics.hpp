@@ -40,8 +40,9 @@ struct DynamicsSettings {
   std::string integrator = "auto";
   /// What the integrator steps: "absolute" (every body's position and orientation, every joint
   /// a constraint) or "joint" (a spanning tree's joint coordinates, only the joints that close
-  /// loops as constraints; see analysis/joint_coordinates.hpp), with every integrator.
-  std::string coordinates = "absolute";
+  /// loops as constraints; see analysis/joint_coordinates.hpp), with every integrator; "auto"
+  /// picks one by the model and the integrator (see choose_coordinates).
+  std::string coordinates = "auto";
   /// The factorization of the linear systems, in the assembly and the integrator: "auto"
   /// (dense for small models, sparse for large ones), "dense", "cholmod" or "klu"; see
   /// linalg/linear_solver.hpp.
@@ -87,6 +88,9 @@ struct RunSummary {
   /// "dop853, then bdf from t = 0.31 s"), and why (empty unless "auto").
   std::string integrator;
   std::string integrator_choice;
+  /// The coordinates the run stepped ("absolute" or "joint") and, for coordinates "auto", why.
+  std::string coordinates;
+  std::string coordinates_choice;
 };
 
 /// An assembled initial state kept to start runs from, so that the setup runs once for several
@@ -646,11 +650,10 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
   return summary;
 }
 
-/// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()).
-/// With `start`, runs after the first start from its assembled state (see AssembledStart).
+/// simulate()'s dispatch by the integrator's name, in the coordinates the settings name.
 template <class Model, class Observer>
-RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                    Observer&& observe, AssembledStart<Model>* start = nullptr) {
+RunSummary simulate_by_name(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                            Observer&& observe, AssembledStart<Model>* start = nullptr) {
   if (s.coordinates == "joint") {
     if (s.integrator == "auto")
       return simulate_auto<JointDormandPrince853, JointBdf, JointGeneralizedAlpha>(model, ws, s,
@@ -670,8 +673,8 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
                          s.integrator +
                          "'; choose one of those, or coordinates 'absolute' for this integrator");
   } else if (s.coordinates != "absolute") {
-    throw ModelError("dynamics",
-                     "unknown coordinates '" + s.coordinates + "'; choose 'absolute' or 'joint'");
+    throw ModelError("dynamics", "unknown coordinates '" + s.coordinates +
+                                     "'; choose 'auto', 'absolute' or 'joint'");
   }
   if (s.integrator == "auto")
     return simulate_auto<DormandPrince853, Bdf, GeneralizedAlpha>(model, ws, s, observe, start);
@@ -685,6 +688,104 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
   throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);
+}
+
+/// Closure equations up to which coordinates "auto" takes joint coordinates. Each factorization
+/// there forms the closures' dense Schur complement from as many passes over the tree, which
+/// beyond a few tens of equations costs more than the absolute coordinates' sparse path: dop853
+/// on chains of spatial four-bars ran 3.7 to 5.7 times faster in joint coordinates with 10 to 25
+/// closure equations, and 0.6 times as fast with 50 (docs/integrators.md, "Which coordinates").
+inline constexpr int auto_joint_closure_limit = 30;
+
+struct CoordinatesChoice {
+  std::string coordinates;  // "absolute" or "joint"
+  std::string reason;       // for RunSummary::coordinates_choice
+};
+
+/// What coordinates "auto" runs. Joint coordinates where they were measured faster at the same
+/// error, and give the same answers: spatial models whose spanning tree leaves at most
+/// auto_joint_closure_limit closure equations, run by the methods whose cost is evaluating the
+/// accelerations (auto, dop853, dopri5, adams); the spatial engine runs 2.3 to 2.6 times faster
+/// there. Absolute coordinates otherwise: planar models (joint coordinates cost 0.9 to 1.5
+/// times as much there), the implicit methods named (their Newton matrices in joint
+/// coordinates leave out the blocks of springs that join two bodies), redundant constraints
+/// (absolute coordinates give their minimum-norm reactions, joint ones pin them), and, for
+/// "auto", a force element that joins two moving bodies (the run may turn to bdf).
+template <class Model>
+CoordinatesChoice choose_coordinates(const Model& model, const DynamicsSettings& s,
+                                     const std::vector<RedundantEquation>& redundant) {
+  const auto absolute = [](const std::string& why) {
+    return CoordinatesChoice{"absolute", "auto: absolute coordinates (" + why + ")"};
+  };
+  if constexpr (!std::is_same_v<typename Model::Space, Spatial>) {
+    return absolute("a planar model: joint coordinates would cost about as much");
+  } else {
+    const bool explicit_method =
+        s.integrator == "dop853" || s.integrator == "dopri5" || s.integrator == "adams";
+    if (!explicit_method && s.integrator != "auto")
+      return absolute(s.integrator +
+                      " is implicit: its Newton matrix in joint coordinates would leave out the "
+                      "blocks of springs between bodies");
+    if (!redundant.empty())
+      return absolute(std::to_string(redundant.size()) + " redundant constraint equation" +
+                      (redundant.size() == 1 ? "" : "s") +
+                      ", whose reactions are the minimum-norm ones there");
+    const int closures = JointCoordinates<Model>::closure_equations(model);
+    if (closures > auto_joint_closure_limit)
+      return absolute(std::to_string(closures) +
+                      " closure equations beyond the spanning tree: their dense Schur "
+                      "complement would cost more than the sparse path");
+    if (s.integrator == "auto" && detail::couples_bodies(model))
+      return absolute(
+          "a force element joins two moving bodies: if the run turns stiff, bdf's Newton "
+          "matrix in joint coordinates would leave its blocks out");
+    return {"joint", "auto: joint coordinates (a spatial model whose spanning tree leaves " +
+                         std::to_string(closures) + " closure equations)"};
+  }
+}
+
+/// Runs a dynamic analysis with the integrator and the coordinates ("absolute" or "joint")
+/// named in the settings.
+template <class Model, class Observer>
+RunSummary simulate_in_coordinates(const Model& model, Workspace<Model>& ws,
+                                   const DynamicsSettings& s, Observer&& observe,
+                                   AssembledStart<Model>* start = nullptr) {
+  RunSummary summary = simulate_by_name(model, ws, s, observe, start);
+  summary.coordinates = s.coordinates;
+  return summary;
+}
+
+/// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()),
+/// in the settings' coordinates; for "auto", those of choose_coordinates, after the assembly
+/// (which finds redundant equations), the run starting from its state. With `start`, runs after
+/// the first start from its assembled state (see AssembledStart).
+template <class Model, class Observer>
+RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                    Observer&& observe, AssembledStart<Model>* start = nullptr) {
+  if (s.coordinates != "auto") return simulate_in_coordinates(model, ws, s, observe, start);
+  const auto& known = integrator_names();
+  if (std::none_of(known.begin(), known.end(),
+                   [&](const auto& entry) { return entry.first == s.integrator; })) {
+    DynamicsSettings named = s;  // refused by name, before any assembly
+    named.coordinates = "absolute";
+    return simulate_in_coordinates(model, ws, named, observe, start);
+  }
+  const auto started = std::chrono::steady_clock::now();
+  AssembledStart<Model> local;
+  AssembledStart<Model>* kept = start != nullptr ? start : &local;
+  const RunSummary assembled = detail::start_run(model, ws, s, kept);
+  const double assembly_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const CoordinatesChoice choice = choose_coordinates(model, s, assembled.redundant_equations);
+  DynamicsSettings chosen = s;
+  chosen.coordinates = choice.coordinates;
+  RunSummary summary = simulate_in_coordinates(model, ws, chosen, observe, kept);
+  // The run started from the state assembled above: count that assembly as this run's.
+  summary.assembly_reused = assembled.assembly_reused;
+  summary.setup_seconds += assembly_seconds;
+  summary.wall_seconds += assembly_seconds;
+  summary.coordinates_choice = choice.reason;
+  return summary;
 }
 
 }  // namespace odyn

@@ -13,8 +13,8 @@ from typing import List, NoReturn, Optional, Tuple
 import numpy as np
 
 from . import _core
-from .results import (ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Interrupted, Result, chosen_integrator,
-                      integrators)
+from .results import (ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Interrupted, Result,
+                      chosen_integrator, integrators)
 from .scene import Scene, load, write_table
 
 
@@ -40,10 +40,10 @@ def _parser() -> argparse.ArgumentParser:
                      "error control for generalized-alpha and hht; --h is then the first step)")
     run.add_argument("--atol", type=float, help="absolute local error tolerance (likewise)")
     run.add_argument("--max-step", type=float, help="largest step with error control, s")
-    run.add_argument("--coordinates", choices=["absolute", "joint"],
-                     help="any model and integrator: step joint coordinates of a "
-                     "spanning tree (recursive, linear in the number of bodies), loops closed "
-                     "by constraints (default: absolute)")
+    run.add_argument("--coordinates", choices=COORDINATES,
+                     help="absolute, or joint coordinates of a spanning tree (recursive, "
+                     "linear in the number of bodies), loops closed by constraints, with any "
+                     "model and integrator (default: auto, by the model and the integrator)")
     run.add_argument("--linear-solver", choices=LINEAR_SOLVERS,
                      help="factorization of the linear systems: dense for small models, "
                      "sparse (cholmod, klu) for large ones (default: auto, by size)")
@@ -120,6 +120,8 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
                  "constraint equations")
     if s and s.get("integrator_choice"):
         lines.append(f"  {s['integrator_choice']}")
+    if s and s.get("coordinates_choice"):
+        lines.append(f"  {s['coordinates_choice']}")
     if s:
         steps = s["steps"]
         lines.append(f"  steps {steps} (events {s['events']}, rejected {s['rejected_steps']}), "

@@ -303,6 +303,7 @@ def _warn(result: Result) -> None:
 
 #: The factorizations `linear_solver` may name (see `simulate`).
 LINEAR_SOLVERS = ["auto", "dense", "cholmod", "klu"]
+COORDINATES = ["auto", "absolute", "joint"]
 
 
 def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 50,
@@ -330,7 +331,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
              constraint_tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None,
              projection_tolerance: Optional[float] = None,
-             order: Optional[int] = None, coordinates: str = "absolute",
+             order: Optional[int] = None, coordinates: str = "auto",
              linear_solver: str = "auto") -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
@@ -357,11 +358,16 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
     iteration of generalized-alpha and hht.
 
-    coordinates: "absolute" (every body's position and orientation, every joint a constraint)
-    or, with any integrator, "joint": the bodies located through a spanning tree of revolute,
-    translational, cylindrical, universal, fixed and spherical joints (planar models: revolute,
-    translational and fixed), only the joints that close loops (distances, drivers, the rest) as constraints.
-    Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
+    coordinates: "auto" (the default) picks joint coordinates for a spatial model whose
+    spanning tree leaves few closure equations (at most 30: the engine's 3), run by auto, dop853,
+    dopri5 or adams, unless it has redundant constraints or, for auto, a spring, damper or
+    bushing between two moving bodies; absolute coordinates otherwise (planar models, the
+    implicit methods named, many loops). `summary["coordinates"]` says which ran and
+    `summary["coordinates_choice"]` why. "absolute": every body's position and orientation,
+    every joint a constraint. "joint", with any integrator: the bodies located through a
+    spanning tree of revolute, translational, cylindrical, universal, fixed and spherical
+    joints (planar models: revolute, translational and fixed), only the joints that close
+    loops (distances, drivers, the rest) as constraints. Fewer unknowns, and each evaluation costs time linear in the number of bodies (recursive
     dynamics); reactions and outputs are the same as in absolute coordinates. Generalized-alpha,
     hht and bdf there leave the spring and damper blocks that join two bodies out of Newton's
     matrix: stiff ones converge better in absolute coordinates. Redundant loop closures are
@@ -391,8 +397,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          max_iterations=max_iterations,
                          projection_tolerance=projection_tolerance,
                          order=_check_order(order),
-                         coordinates=check_choice(coordinates, "coordinates",
-                                                  ["absolute", "joint"]),
+                         coordinates=check_choice(coordinates, "coordinates", COORDINATES),
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
     data = _core.simulate(model._core, settings, progress)

@@ -13,7 +13,7 @@
       "analysis": {"t_end": 1.0, "output_interval": 1e-3},   (+ integrator, rho_inf, step,
                    rtol, atol, max_step, adaptive, newton_rtol, newton_atol,
                    constraint_tolerance, max_iterations, projection_tolerance, order,
-                   coordinates ("absolute" or "joint"); the integrator is a name of
+                   coordinates ("auto", "absolute" or "joint"); the integrator is a name of
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
                    generalized-alpha when a step is given without rtol and atol)
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
@@ -38,7 +38,7 @@ import numpy as np
 from . import _schema
 from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
 from .model import BaseModel, Model, new_model
-from .results import ADAPTIVE_OPTIONAL, LINEAR_SOLVERS, Result, integrators, simulate
+from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
@@ -171,7 +171,7 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                     fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
                 out[key] = d[key]
             elif key == "coordinates":
-                out[key] = check_choice(d[key], f"{where}.{key}", ["absolute", "joint"])
+                out[key] = check_choice(d[key], f"{where}.{key}", COORDINATES)
             elif key == "linear_solver":
                 out[key] = check_choice(d[key], f"{where}.{key}", LINEAR_SOLVERS)
             elif key == "order":

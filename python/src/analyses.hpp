@@ -270,6 +270,8 @@ inline py::dict run_summary(const RunSummary& s) {
   d["warnings"] = warning_list(s.warnings);
   d["integrator"] = s.integrator;
   d["integrator_choice"] = s.integrator_choice;
+  d["coordinates"] = s.coordinates;
+  d["coordinates_choice"] = s.coordinates_choice;
   py::dict assembly = assembly_report(s.assembly);
   assembly["redundant_equations"] = redundant_list(s.redundant_equations);
   assembly["reused"] = s.assembly_reused;

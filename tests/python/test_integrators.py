@@ -227,9 +227,30 @@ def test_the_default_is_auto_and_a_step_alone_means_generalized_alpha(exact_angl
     chosen = odyn.simulate(pendulum(), t_end=1.0, output_interval=0.1)
     assert chosen.summary["integrator"] == "dop853"
     assert "not stiff" in chosen.summary["integrator_choice"]
+    assert chosen.summary["coordinates"] == "absolute"  # a planar model
+    assert "planar" in chosen.summary["coordinates_choice"]
     # rtol = atol = 1e-6 by default; the pendulum's angle to about that.
     np.testing.assert_allclose(chosen.body("bob").angle, exact_angle, atol=1e-5)
     fixed = odyn.simulate(pendulum(), t_end=1.0, step=1e-3, output_interval=0.1)
     assert fixed.summary["integrator"] == "generalized-alpha"
     assert fixed.summary["integrator_choice"] == ""
     assert fixed.statistics.steps == 1000
+
+
+def test_auto_coordinates_are_joint_ones_for_the_engine_with_the_same_answer():
+    """The engine (spatial, 3 closure equations) runs in joint coordinates by default with an
+    explicit method, and ends where a run in absolute coordinates does."""
+    scene = odyn.load(ENGINE_SCENE)
+    chosen = scene.simulate(t_end=0.1, integrator="auto", rtol=1e-9, atol=1e-9)
+    assert chosen.summary["coordinates"] == "joint"
+    assert "3 closure equations" in chosen.summary["coordinates_choice"]
+    absolute = scene.simulate(t_end=0.1, integrator="auto", rtol=1e-9, atol=1e-9,
+                              coordinates="absolute")
+    assert absolute.summary["coordinates"] == "absolute"
+    assert absolute.summary["coordinates_choice"] == ""
+    np.testing.assert_allclose(chosen.state("gas force")["theta"],
+                               absolute.state("gas force")["theta"], atol=1e-7)
+    # The scene's own integrator, generalized-alpha, is implicit: absolute coordinates.
+    named = scene.simulate(t_end=0.01)
+    assert named.summary["coordinates"] == "absolute"
+    assert "implicit" in named.summary["coordinates_choice"]

@@ -180,6 +180,20 @@ class JointCoordinates {
     initial_state();
   }
 
+  /// The closures' equations that the model's spanning tree leaves (the size of the dense
+  /// Schur complement each factorization forms), from its joints alone: no state needed.
+  static int closure_equations(const Model& model) {
+    std::vector<Edge> edges;
+    const TreeFlags in_tree = spanning_tree(model, edges);
+    int count = 0;
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+      if constexpr (Constraint<E>)
+        for (std::size_t i = 0; i < pool.size(); ++i)
+          if (!in_tree[type][i]) count += E::num_equations;
+    });
+    return count;
+  }
+
   Eigen::Index num_positions() const { return q_.size(); }
   Eigen::Index num_velocities() const { return v_.size(); }
   Eigen::Index num_equations() const { return phi_.size(); }
@@ -1053,34 +1067,46 @@ class JointCoordinates {
     int a, b, equations;
   };
 
-  void build_tree() {
-    const int nb = model_.num_bodies();
-    std::vector<Edge> edges;
-    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+  using TreeFlags = std::array<std::vector<bool>, Model::num_types>;  // per pool: in the tree?
+
+  /// The joints that carry bodies, most equations first, and which of them Kruskal's spanning
+  /// tree takes (so that the loops close with the fewest equations).
+  static TreeFlags spanning_tree(const Model& model, std::vector<Edge>& edges) {
+    edges.clear();
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
       if constexpr (Algebra::template carries_body<E>)
         for (std::size_t i = 0; i < pool.size(); ++i)
           edges.push_back(
               {type, i, pool[i].bodies()[0].index, pool[i].bodies()[1].index, E::num_equations});
     });
-    // Kruskal: most equations first, so the loops close with the fewest.
     std::stable_sort(edges.begin(), edges.end(),
                      [](const Edge& x, const Edge& y) { return x.equations > y.equations; });
-    std::vector<int> group(nb + 1);
+    std::vector<int> group(model.num_bodies() + 1);
     std::iota(group.begin(), group.end(), 0);
     const auto root = [&](int x) {
       while (group[x] != x) x = group[x] = group[group[x]];
       return x;
     };
-    std::vector<std::vector<std::pair<int, int>>> neighbours(nb + 1);  // (body, edge)
-    std::array<std::vector<bool>, Model::num_types> in_tree;
-    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    TreeFlags in_tree;
+    model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
       in_tree[type].assign(pool.size(), false);
     });
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-      const int ra = root(edges[e].a), rb = root(edges[e].b);
+    for (const Edge& edge : edges) {
+      const int ra = root(edge.a), rb = root(edge.b);
       if (ra == rb) continue;
       group[ra] = rb;
-      in_tree[edges[e].type][edges[e].index] = true;
+      in_tree[edge.type][edge.index] = true;
+    }
+    return in_tree;
+  }
+
+  void build_tree() {
+    const int nb = model_.num_bodies();
+    std::vector<Edge> edges;
+    const TreeFlags in_tree = spanning_tree(model_, edges);
+    std::vector<std::vector<std::pair<int, int>>> neighbours(nb + 1);  // (body, edge)
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      if (!in_tree[edges[e].type][edges[e].index]) continue;
       neighbours[edges[e].a].push_back({edges[e].b, static_cast<int>(e)});
       neighbours[edges[e].b].push_back({edges[e].a, static_cast<int>(e)});
     }
