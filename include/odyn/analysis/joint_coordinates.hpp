@@ -627,7 +627,13 @@ class JointCoordinates {
       q.template head<Space::dim>() = frame.position;
       if constexpr (spatial_model) {
         const Eigen::Quaterniond rotation(frame.rotation);
-        q.template tail<4>() << rotation.w(), rotation.x(), rotation.y(), rotation.z();
+        Eigen::Vector4d quaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z());
+        // The axes fix the quaternion up to its sign: keep the one nearest the workspace's
+        // last (the previous output's, or the assembled start's), so that the outputs run on
+        // continuously, as an absolute-coordinate run's do (while a body turns by less than a
+        // half turn between outputs).
+        if (quaternion.dot(q.template tail<4>()) < 0.0) quaternion = -quaternion;
+        q.template tail<4>() = quaternion;
       } else {
         q[2] = frame.angle;
       }
