@@ -693,8 +693,8 @@ RunSummary simulate_by_name(const Model& model, Workspace<Model>& ws, const Dyna
 /// Closure equations up to which coordinates "auto" takes joint coordinates. Each factorization
 /// there forms the closures' dense Schur complement from as many passes over the tree, which
 /// beyond a few tens of equations costs more than the absolute coordinates' sparse path: dop853
-/// on chains of spatial four-bars ran 3.7 to 5.7 times faster in joint coordinates with 10 to 25
-/// closure equations, and 0.6 times as fast with 50 (docs/integrators.md, "Which coordinates").
+/// on chains of spatial four-bars ran 4.0 to 4.6 times faster in joint coordinates with 10 to 25
+/// closure equations, and 0.66 times as fast with 50 (docs/integrators.md, "Which coordinates").
 inline constexpr int auto_joint_closure_limit = 30;
 
 struct CoordinatesChoice {
@@ -706,8 +706,8 @@ struct CoordinatesChoice {
 /// error, and give the same answers: spatial models whose spanning tree leaves at most
 /// auto_joint_closure_limit closure equations, run by the methods whose cost is evaluating the
 /// accelerations (auto, dop853, dopri5, adams); the spatial engine runs 2.3 to 2.6 times faster
-/// there. Absolute coordinates otherwise: planar models (joint coordinates cost 0.9 to 1.5
-/// times as much there), the implicit methods named (their Newton matrices in joint
+/// there. Absolute coordinates otherwise: planar models (joint coordinates ran 0.94 to 1.7
+/// times as fast there), the implicit methods named (their Newton matrices in joint
 /// coordinates leave out the blocks of springs that join two bodies), redundant constraints
 /// (absolute coordinates give their minimum-norm reactions, joint ones pin them), and, for
 /// "auto", a force element that joins two moving bodies (the run may turn to bdf).
