@@ -35,8 +35,8 @@ def rope(links, moving):
     for i in range(links):
         name = f"link{i}"
         model.add_body(name, 1.0, (5e-5, 1 / 12, 1 / 12), position=(0.5 + i, 0, 0), **velocity)
-        model.add_spherical(f"ball{i}", previous, (0, 0, 0) if i == 0 else (0.5, 0, 0), name,
-                            (-0.5, 0, 0))
+        model.add_spherical(f"ball{i}", previous, point_a=(0, 0, 0) if i == 0 else (0.5, 0, 0),
+                            body_b=name, point_b=(-0.5, 0, 0))
         previous = name
     model.add_gravity("gravity", (0, 0, -9.81))
     return model

@@ -44,7 +44,45 @@ class GasForceT {
   };
 
   GasForceT(std::string name, odyn::BodyId crank, odyn::BodyId piston, Parameters p)
-      : name_(std::move(name)), bodies_{crank, piston}, p_(p) {}
+      : name_(std::move(name)), bodies_{crank, piston}, p_(p) {
+    if (!(p.r > 0.0) || !(p.L > p.r) || !(p.D > 0.0) || !(p.C > 1.0) || !(p.p_atm > 0.0) ||
+        !(p.kappa > 0.0) || !(p.p_comb >= 0.0) || !std::isfinite(p.L + p.C + p.p_comb))
+      throw odyn::ModelError(name_,
+                             "expected finite r > 0, L > r, D > 0, compression ratio C > 1, "
+                             "p_atm > 0, kappa > 0 and p_comb >= 0; got r = " +
+                                 odyn::to_text(p.r) + ", L = " + odyn::to_text(p.L) +
+                                 ", D = " + odyn::to_text(p.D) + ", C = " + odyn::to_text(p.C));
+  }
+
+  // How front ends (Python, scene files) see it; the defaults are the spec's.
+  static constexpr std::array<odyn::Parameter, 10> parameter_list{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"crank", "body", nullptr, "", "the crank, whose angle sets the cycle"},
+      {"piston", "body", nullptr, "", "the piston, on which the force acts"},
+      {"r", "positive", "0.04", "m", "crank radius"},
+      {"L", "positive", "0.14", "m", "connecting rod length"},
+      {"D", "positive", "0.08", "m", "bore"},
+      {"C", "positive", "9.0", "", "compression ratio"},
+      {"p_atm", "positive", "101325.0", "Pa", "atmospheric pressure"},
+      {"kappa", "positive", "1.4", "", "ratio of specific heats"},
+      {"p_comb", "nonnegative", "3.0e6", "Pa", "pressure rise of combustion"},
+  }};
+  static constexpr odyn::ElementDescription description{
+      "engine_gas_force", "force",
+      "The engine's Otto-cycle gas force on the piston along the cylinder axis (Z; y in the "
+      "plane), the crank angle read from the crank's rotation; events at each half turn.",
+      parameter_list};
+  template <class Reader>
+  static GasForceT from_parameters(Reader& r) {
+    using odyn::parameter;
+    Parameters p;
+    p.r = parameter<double>(r, "r"), p.L = parameter<double>(r, "L");
+    p.D = parameter<double>(r, "D"), p.C = parameter<double>(r, "C");
+    p.p_atm = parameter<double>(r, "p_atm"), p.kappa = parameter<double>(r, "kappa");
+    p.p_comb = parameter<double>(r, "p_comb");
+    return GasForceT(parameter<std::string>(r, "name"), parameter<odyn::BodyId>(r, "crank"),
+                     parameter<odyn::BodyId>(r, "piston"), p);
+  }
 
   const std::string& name() const { return name_; }
   const std::array<odyn::BodyId, 2>& bodies() const { return bodies_; }

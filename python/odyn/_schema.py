@@ -8,6 +8,7 @@ floats, dicts) or raise `SceneError` naming the place (``joints[2].axis``) and w
 from __future__ import annotations
 
 import itertools
+import json
 import math
 from typing import (Any, Callable, Collection, Dict, List, Mapping, NoReturn, Optional, Sequence,
                     Tuple)
@@ -194,117 +195,88 @@ def _bodies(x, where, bodies):
     return [_body(b, f"{where}[{i}]", bodies) for i, b in enumerate(x)]
 
 
-def _vector_or_callable(x, where, bodies):
-    return x if callable(x) else check_vector(x, where)
+def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[Any, str, Any],
+                                                                          Any]]:
+    """How each parameter kind (odyn/core/description.hpp) checks a value in a space whose
+    vectors have `dim` components."""
+
+    def vector_or_callable(x, where, bodies):
+        return x if callable(x) else check_vector(x, where, dim)
+
+    def angular_or_callable(x, where, bodies):
+        if callable(x):
+            return x
+        return check_vector(x, where) if dim == 3 else check_number(x, where)
+
+    return {
+        "name": lambda x, w, b: check_name(x, w),
+        "body": _body,
+        "bodies": _bodies,
+        "joint": lambda x, w, b: check_name(x, w),
+        "vector": lambda x, w, b: check_vector(x, w, dim),
+        "frame": lambda x, w, b: frame({} if x is None else x, w),
+        "number": lambda x, w, b: check_number(x, w),
+        "nonnegative": lambda x, w, b: check_number(x, w, minimum=0.0),
+        "positive": lambda x, w, b: check_number(x, w, positive=True),
+        "axes": lambda x, w, b: check_choice(x, w, ("global", "body")),
+        "motion": lambda x, w, b: check_motion(x, w),
+        "vector_or_callable": vector_or_callable,
+        "angular_or_callable": angular_or_callable,
+        "optional_callable": lambda x, w, b: None if x is None else check_callable(x, w),
+        "callable": lambda x, w, b: check_callable(x, w),
+    }
 
 
-def _vector2_or_callable(x, where, bodies):
-    return x if callable(x) else check_vector(x, where, 2)
+#: Each space's parameter kinds: kind -> check(value, where, bodies) -> normalized value.
+SPACE_KINDS = {"spatial": _kinds(3, check_frame), "planar": _kinds(2, check_planar_frame)}
+
+#: What each kind means, from the compiled core (for the documentation).
+KIND_DOCS: Dict[str, str] = dict(_core.parameter_kinds)
+assert set(KIND_DOCS) == set(SPACE_KINDS["spatial"]), "a parameter kind without its check, or the reverse"
 
 
-def _number_or_callable(x, where, bodies):
-    return x if callable(x) else check_number(x, where)
+def _default(kind: str, text: Optional[str], dim: int) -> Any:
+    """A parameter's default from its JSON text; a vector's 0 is the zero vector."""
+    if text is None:
+        return REQUIRED
+    value = json.loads(text)
+    if kind == "vector" and value == 0:
+        return [0.0] * dim
+    return value
 
 
-def _optional_callable(x, where, bodies):
-    return None if x is None else check_callable(x, where)
+def _catalogue(described: Sequence[Mapping[str, Any]], dim: int) -> Dict[str, Dict[str, Any]]:
+    """type -> its description (from the compiled core), with `spec`: parameter -> (kind,
+    default) in the description's order."""
+    out: Dict[str, Dict[str, Any]] = {}
+    for element in described:
+        spec = {p["name"]: (p["kind"], _default(p["kind"], p["default"], dim))
+                for p in element["parameters"]}
+        out[element["type"]] = {**element, "spec": spec}
+    return out
 
 
-KINDS: Dict[str, Callable[[Any, str, List[str]], Any]] = {
-    "name": lambda x, w, b: check_name(x, w),
-    "body": _body,
-    "bodies": _bodies,
-    "vector": lambda x, w, b: check_vector(x, w),
-    "frame": lambda x, w, b: check_frame(x, w),
-    "number": lambda x, w, b: check_number(x, w),
-    "nonnegative": lambda x, w, b: check_number(x, w, minimum=0.0),
-    "positive": lambda x, w, b: check_number(x, w, positive=True),
-    "axes": lambda x, w, b: check_choice(x, w, ("global", "body")),
-    "motion": lambda x, w, b: check_motion(x, w),
-    "vector_or_callable": _vector_or_callable,
-    "vector2": lambda x, w, b: check_vector(x, w, 2),
-    "planar_frame": lambda x, w, b: check_planar_frame(x, w),
-    "vector2_or_callable": _vector2_or_callable,
-    "number_or_callable": _number_or_callable,
-    "optional_callable": _optional_callable,
-    "callable": lambda x, w, b: check_callable(x, w),
-}
+#: Every element type of each space, as the compiled core describes it: type -> {type,
+#: category ("joint", "driver", "force"), summary, parameters, spec}.
+DESCRIPTIONS = {"spatial": _catalogue(_core.element_catalogue, 3),
+                "planar": _catalogue(_core.planar_element_catalogue, 2)}
 
-_PAIR = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED), "on_a": ("frame", REQUIRED),
-         "body_b": ("body", REQUIRED), "on_b": ("frame", REQUIRED)}
-_POINTS = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
-           "point_a": ("vector", [0.0, 0.0, 0.0]), "body_b": ("body", REQUIRED),
-           "point_b": ("vector", [0.0, 0.0, 0.0])}
-
-#: Every element type: parameter -> (kind, default). Names and order follow the C++ constructors.
+#: Every element type: parameter -> (kind, default). Names and order follow the C++ descriptions.
 ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
-    "revolute": _PAIR,
-    "translational": _PAIR,
-    "spherical": _POINTS,
-    "universal": _PAIR,
-    "cylindrical": _PAIR,
-    "fixed": _PAIR,
-    "distance": {**_POINTS, "length": ("number", 0.0)},
-    "revolute_driver": {**_PAIR, "motion": ("motion", REQUIRED)},
-    "translational_driver": {**_PAIR, "motion": ("motion", REQUIRED)},
-    "gravity": {"name": ("name", REQUIRED), "acceleration": ("vector", REQUIRED)},
-    "point_force": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
-                    "point": ("vector", [0.0, 0.0, 0.0]),
-                    "force": ("vector_or_callable", REQUIRED), "axes": ("axes", "global")},
-    "point_torque": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
-                     "torque": ("vector_or_callable", REQUIRED), "axes": ("axes", "global")},
-    "tsda": {**_POINTS, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
-             "free_length": ("nonnegative", 0.0), "actuator": ("optional_callable", None)},
-    "rsda": {**_PAIR, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
-             "free_angle": ("number", 0.0), "actuator": ("optional_callable", None)},
-    # The engine's Otto-cycle gas force (shared/specs/engine.md); defaults are the spec's.
-    "engine_gas_force": {"name": ("name", REQUIRED), "crank": ("body", REQUIRED),
-                         "piston": ("body", REQUIRED), "r": ("positive", 0.04),
-                         "L": ("positive", 0.14), "D": ("positive", 0.08),
-                         "C": ("positive", 9.0), "p_atm": ("positive", 101325.0),
-                         "kappa": ("positive", 1.4), "p_comb": ("nonnegative", 3.0e6)},
-    "user_force": {"name": ("name", REQUIRED), "bodies": ("bodies", REQUIRED),
-                   "function": ("callable", REQUIRED)},
-}
-
-JOINTS = ("revolute", "translational", "spherical", "universal", "cylindrical", "fixed",
-          "distance")
-DRIVERS = ("revolute_driver", "translational_driver")
-FORCES = ("gravity", "point_force", "point_torque", "tsda", "rsda", "engine_gas_force",
-          "user_force")
-assert set(ELEMENTS) == set(JOINTS + DRIVERS + FORCES)
-
-_PLANAR_PAIR = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
-                "on_a": ("planar_frame", None), "body_b": ("body", REQUIRED),
-                "on_b": ("planar_frame", None)}
-_PLANAR_POINTS = {"name": ("name", REQUIRED), "body_a": ("body", REQUIRED),
-                  "point_a": ("vector2", [0.0, 0.0]), "body_b": ("body", REQUIRED),
-                  "point_b": ("vector2", [0.0, 0.0])}
-
-#: Every planar element type (odyn::planar, plus the engine's gas force and Python forces).
+    t: d["spec"] for t, d in DESCRIPTIONS["spatial"].items()}
 PLANAR_ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
-    "revolute": _PLANAR_PAIR,
-    "translational": _PLANAR_PAIR,
-    "fixed": _PLANAR_PAIR,
-    "distance": {**_PLANAR_POINTS, "length": ("number", 0.0)},
-    "revolute_driver": {**_PLANAR_PAIR, "motion": ("motion", REQUIRED)},
-    "translational_driver": {**_PLANAR_PAIR, "motion": ("motion", REQUIRED)},
-    "gravity": {"name": ("name", REQUIRED), "acceleration": ("vector2", REQUIRED)},
-    "point_force": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
-                    "point": ("vector2", [0.0, 0.0]),
-                    "force": ("vector2_or_callable", REQUIRED), "axes": ("axes", "global")},
-    "point_torque": {"name": ("name", REQUIRED), "body": ("body", REQUIRED),
-                     "torque": ("number_or_callable", REQUIRED)},
-    "tsda": {**_PLANAR_POINTS, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
-             "free_length": ("nonnegative", 0.0), "actuator": ("optional_callable", None)},
-    "rsda": {**_PLANAR_PAIR, "stiffness": ("number", 0.0), "damping": ("number", 0.0),
-             "free_angle": ("number", 0.0), "actuator": ("optional_callable", None)},
-    # The engine's gas force in the plane: along y, the crank angle is the crank's angle.
-    "engine_gas_force": ELEMENTS["engine_gas_force"],
-    "user_force": ELEMENTS["user_force"],
-}
-PLANAR_JOINTS = ("revolute", "translational", "fixed", "distance")
-assert set(PLANAR_ELEMENTS) == set(PLANAR_JOINTS + DRIVERS + FORCES)
+    t: d["spec"] for t, d in DESCRIPTIONS["planar"].items()}
+
+
+def _of(space: str, category: str) -> Tuple[str, ...]:
+    return tuple(t for t, d in DESCRIPTIONS[space].items() if d["category"] == category)
+
+
+JOINTS = _of("spatial", "joint")
+PLANAR_JOINTS = _of("planar", "joint")
+DRIVERS = _of("spatial", "driver")
+FORCES = _of("spatial", "force")
+assert _of("planar", "driver") == DRIVERS and set(_of("planar", "force")) == set(FORCES)
 
 #: The element catalogue of each space.
 CATALOGUE = {"spatial": ELEMENTS, "planar": PLANAR_ELEMENTS}
@@ -321,34 +293,39 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     """Normalized parameters of an element of type `kind` in `space`; `elements`: name ->
     (type, params)."""
     spec = CATALOGUE[space][kind]
-    params = dict(params)
-    if kind in DRIVERS and "joint" in params:
-        # Drive an existing joint: take its bodies and frames.
-        joint = check_name(params.pop("joint"), f"{where}.joint")
-        if joint not in elements or elements[joint][0] not in DRIVEN_JOINTS[kind]:
-            fail(f"{where}.joint", f"no {' or '.join(DRIVEN_JOINTS[kind])} joint named "
-                 f"'{joint}' before this driver")
-        for key in ("body_a", "on_a", "body_b", "on_b"):
-            if key in params:
-                fail(f"{where}.{key}", "give either 'joint' or the bodies and frames, not both")
-            params[key] = elements[joint][1][key]
-    check_keys(params, where, list(spec),
-               [k for k, (_, default) in spec.items() if default is REQUIRED])
+    kinds = SPACE_KINDS[space]
+    params = {k: v for k, v in params.items() if not (k == "joint" and v is None)}
+    required = [k for k, (_, default) in spec.items() if default is REQUIRED]
+    if kind in DRIVERS:
+        if "joint" in params:
+            # Drive an existing joint: take its bodies and frames.
+            joint = check_name(params.pop("joint"), f"{where}.joint")
+            if joint not in elements or elements[joint][0] not in DRIVEN_JOINTS[kind]:
+                fail(f"{where}.joint", f"no {' or '.join(DRIVEN_JOINTS[kind])} joint named "
+                     f"'{joint}' before this driver")
+            for key in ("body_a", "on_a", "body_b", "on_b"):
+                if params.get(key) is not None:
+                    fail(f"{where}.{key}",
+                         "give either 'joint' or the bodies and frames, not both")
+                params[key] = elements[joint][1][key]
+        else:
+            required += ["body_a", "body_b"]
+    check_keys(params, where, list(spec), required)
     out: Dict[str, Any] = {}
     for key, (param_kind, default) in spec.items():
+        if key == "joint":
+            continue  # resolved above into the bodies and frames
         value = params.get(key, default)
-        if value is None and param_kind == "planar_frame":  # the body's origin, axis left out
-            value = {}
-        out[key] = KINDS[param_kind](value, f"{where}.{key}", bodies)
+        out[key] = kinds[param_kind](value, f"{where}.{key}", bodies)
     if out["name"] in elements or out["name"] in bodies:
         fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
-    if kind in ("spherical", "distance", "tsda") or "on_a" in spec:
-        if out["body_a"] == out["body_b"]:
-            fail(f"{where}.body_b", f"body_a and body_b are both '{out['body_a']}'; "
-                 "expected two different bodies")
-    if kind == "engine_gas_force" and out["crank"] == out["piston"]:
-        fail(f"{where}.piston", "crank and piston must be two different bodies")
-    if kind == "user_force" and len(set(out["bodies"])) != len(out["bodies"]):
+    named = [key for key, (param_kind, _) in spec.items() if param_kind == "body"]
+    for i, key in enumerate(named):
+        for other in named[:i]:
+            if out[key] == out[other]:
+                fail(f"{where}.{key}", f"{other} and {key} are both '{out[key]}'; expected "
+                     "two different bodies")
+    if "bodies" in out and len(set(out["bodies"])) != len(out["bodies"]):
         fail(f"{where}.bodies", "the bodies must be different")
     return out
 
@@ -383,9 +360,9 @@ PLANAR_BODY: Dict[str, Tuple[str, Any]] = {
     "name": ("name", REQUIRED),
     "mass": ("positive", REQUIRED),
     "inertia": ("positive", REQUIRED),
-    "position": ("vector2", [0.0, 0.0]),
+    "position": ("vector", [0.0, 0.0]),
     "angle": ("number", 0.0),
-    "linear_velocity": ("vector2", [0.0, 0.0]),
+    "linear_velocity": ("vector", [0.0, 0.0]),
     "angular_velocity": ("number", 0.0),
     "velocity_given": ("flags", None),
 }
@@ -411,7 +388,7 @@ def check_body(params: Mapping[str, Any], where: str, names: Sequence[str],
                 fail(w, f"expected a list of {flags} booleans ({what}), got {_describe(value)}")
             out[key] = None if value is None else list(value)
         else:
-            out[key] = KINDS[kind](value, w, [])
+            out[key] = SPACE_KINDS[space][kind](value, w, [])
     if out["name"] in names or out["name"] == "ground":
         fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
     return out

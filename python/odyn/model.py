@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from . import _core, _schema
+from ._elements import PlanarElements, SpatialElements
 from ._schema import SceneError
 
 Vector = Sequence[float]
@@ -109,6 +110,10 @@ class BaseModel:
         """Adds an element of the given type (see `element_types`); returns its name."""
         return self._add(type, params, f"{type} '{params.get('name', '?')}'")
 
+    def _add_given(self, type: str, **params: Any) -> str:
+        """`add` with the parameters left at None dropped (the generated add_* methods)."""
+        return self.add(type, **{k: v for k, v in params.items() if v is not None})
+
     def _add(self, kind: str, params: Mapping[str, Any], where: str) -> str:
         catalogue = _schema.CATALOGUE[self.space]
         if kind not in catalogue:
@@ -173,7 +178,7 @@ class BaseModel:
                 f"{self.num_equations} constraint equations>")
 
 
-class Model(BaseModel):
+class Model(BaseModel, SpatialElements):
     """A spatial model: bodies with 6 velocity coordinates (odyn::spatial). See `BaseModel`."""
 
     space = "spatial"
@@ -196,114 +201,8 @@ class Model(BaseModel):
                       angular_velocity=angular_velocity, velocity_given=velocity_given)
         return self._add_body(params, f"body '{name}'")
 
-    # --- elements (spatial) -------------------------------------------------------------
-    def add_revolute(self, name: str, body_a: str, on_a: Frame, body_b: str, on_b: Frame) -> str:
-        """Revolute (hinge): the joint points coincide, the axes stay parallel. 5 equations."""
-        return self.add("revolute", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
 
-    def add_translational(self, name: str, body_a: str, on_a: Frame, body_b: str,
-                          on_b: Frame) -> str:
-        """Translational (prismatic): b slides along a's axis without turning. 5 equations."""
-        return self.add("translational", name=name, body_a=body_a, on_a=on_a, body_b=body_b,
-                        on_b=on_b)
-
-    def add_spherical(self, name: str, body_a: str, point_a: Vector, body_b: str,
-                      point_b: Vector) -> str:
-        """Spherical (ball): the two points coincide. 3 equations."""
-        return self.add("spherical", name=name, body_a=body_a, point_a=point_a, body_b=body_b,
-                        point_b=point_b)
-
-    def add_universal(self, name: str, body_a: str, on_a: Frame, body_b: str, on_b: Frame) -> str:
-        """Universal (Cardan): points coincide, the two cross axes stay perpendicular. 4 eq."""
-        return self.add("universal", name=name, body_a=body_a, on_a=on_a, body_b=body_b,
-                        on_b=on_b)
-
-    def add_cylindrical(self, name: str, body_a: str, on_a: Frame, body_b: str,
-                        on_b: Frame) -> str:
-        """Cylindrical: b slides along and turns about a's axis. 4 equations."""
-        return self.add("cylindrical", name=name, body_a=body_a, on_a=on_a, body_b=body_b,
-                        on_b=on_b)
-
-    def add_fixed(self, name: str, body_a: str, on_a: Frame, body_b: str, on_b: Frame) -> str:
-        """Fixed (weld): the joint frames stay together. 6 equations."""
-        return self.add("fixed", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
-
-    def add_distance(self, name: str, body_a: str, point_a: Vector, body_b: str,
-                     point_b: Vector, length: float = 0.0) -> str:
-        """Distance (massless rod): the points keep their distance (length <= 0: the initial
-        one). 1 equation."""
-        return self.add("distance", name=name, body_a=body_a, point_a=point_a, body_b=body_b,
-                        point_b=point_b, length=length)
-
-    def add_revolute_driver(self, name: str, motion: Mapping[str, Any], joint: Optional[str] = None,
-                            **bodies_and_frames: Any) -> str:
-        """The angle of b about a's axis follows motion g(t). Give `joint` (a revolute joint's
-        name) or body_a, on_a, body_b, on_b. 1 equation."""
-        params = dict(name=name, motion=motion, **bodies_and_frames)
-        if joint is not None:
-            params["joint"] = joint
-        return self.add("revolute_driver", **params)
-
-    def add_translational_driver(self, name: str, motion: Mapping[str, Any],
-                                 joint: Optional[str] = None, **bodies_and_frames: Any) -> str:
-        """The slide of b along a's axis follows motion g(t). Give `joint` (a translational or
-        cylindrical joint's name) or body_a, on_a, body_b, on_b. 1 equation."""
-        params = dict(name=name, motion=motion, **bodies_and_frames)
-        if joint is not None:
-            params["joint"] = joint
-        return self.add("translational_driver", **params)
-
-    def add_gravity(self, name: str, acceleration: Vector) -> str:
-        """Uniform gravity on every body (m/s^2)."""
-        return self.add("gravity", name=name, acceleration=acceleration)
-
-    def add_point_force(self, name: str, body: str, force: Union[Vector, FrameFunction],
-                        point: Vector = (0, 0, 0), axes: str = "global") -> str:
-        """A force at a body point: constant, or force(t, body) -> 3 numbers, in "global" or
-        "body" axes. A Python function costs 0.2 to 0.6 us per call (bench/python_user_force.py)."""
-        return self.add("point_force", name=name, body=body, point=point, force=force, axes=axes)
-
-    def add_point_torque(self, name: str, body: str, torque: Union[Vector, FrameFunction],
-                         axes: str = "global") -> str:
-        """A torque on a body: constant, or torque(t, body) -> 3 numbers."""
-        return self.add("point_torque", name=name, body=body, torque=torque, axes=axes)
-
-    def add_tsda(self, name: str, body_a: str, point_a: Vector, body_b: str, point_b: Vector,
-                 stiffness: float = 0.0, damping: float = 0.0, free_length: float = 0.0,
-                 actuator: Optional[Callable[[float, float, float], float]] = None) -> str:
-        """Translational spring-damper-actuator; tension k (L - free_length) + c L' +
-        actuator(t, L, L') pulls the points together."""
-        return self.add("tsda", name=name, body_a=body_a, point_a=point_a, body_b=body_b,
-                        point_b=point_b, stiffness=stiffness, damping=damping,
-                        free_length=free_length, actuator=actuator)
-
-    def add_rsda(self, name: str, body_a: str, on_a: Frame, body_b: str, on_b: Frame,
-                 stiffness: float = 0.0, damping: float = 0.0, free_angle: float = 0.0,
-                 actuator: Optional[Callable[[float, float, float], float]] = None) -> str:
-        """Rotational spring-damper-actuator about a's axis; torque on b
-        -(k (theta - free_angle) + c theta') + actuator(t, theta, theta')."""
-        return self.add("rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
-                        stiffness=stiffness, damping=damping, free_angle=free_angle,
-                        actuator=actuator)
-
-    def add_engine_gas_force(self, name: str, crank: str, piston: str, r: float = 0.04,
-                             L: float = 0.14, D: float = 0.08, C: float = 9.0,
-                             p_atm: float = 101325.0, kappa: float = 1.4,
-                             p_comb: float = 3.0e6) -> str:
-        """The engine's Otto-cycle gas force on the piston along Z (shared/specs/engine.md),
-        with the crank angle read from the crank's rotation about X. Events at each half turn."""
-        return self.add("engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D,
-                        C=C, p_atm=p_atm, kappa=kappa, p_comb=p_comb)
-
-    def add_user_force(self, name: str, bodies: Sequence[str],
-                       function: Callable[..., Any]) -> str:
-        """A force written in Python on one or two bodies: function(t, body_0[, body_1])
-        returns, per body, 6 numbers: the global force at the centre of mass, then the global
-        torque. The body views are refreshed before each call (copy them to keep them)."""
-        return self.add("user_force", name=name, bodies=list(bodies), function=function)
-
-
-class PlanarModel(BaseModel):
+class PlanarModel(BaseModel, PlanarElements):
     """A planar model: bodies of x, y, phi in the x-y plane (odyn::planar). See `BaseModel`.
 
     Joint frames are a point and an axis per body (2-vectors, body coordinates); both may be
@@ -330,104 +229,6 @@ class PlanarModel(BaseModel):
                       linear_velocity=linear_velocity, angular_velocity=angular_velocity,
                       velocity_given=velocity_given)
         return self._add_body(params, f"body '{name}'")
-
-    # --- elements (planar) --------------------------------------------------------------------
-    def add_revolute(self, name: str, *, body_a: str, body_b: str, on_a: Optional[Frame] = None,
-                     on_b: Optional[Frame] = None) -> str:
-        """Revolute (pin): the joint points coincide. 2 equations. Its axes fix the zero of
-        the joint angle that a revolute driver prescribes."""
-        return self.add("revolute", name=name, body_a=body_a, on_a=on_a, body_b=body_b,
-                        on_b=on_b)
-
-    def add_translational(self, name: str, *, body_a: str, body_b: str,
-                          on_a: Optional[Frame] = None, on_b: Optional[Frame] = None) -> str:
-        """Translational (slider): b's point moves along the line through a's point with a's
-        axis, and the bodies do not turn relative to each other. 2 equations."""
-        return self.add("translational", name=name, body_a=body_a, on_a=on_a, body_b=body_b,
-                        on_b=on_b)
-
-    def add_fixed(self, name: str, *, body_a: str, body_b: str, on_a: Optional[Frame] = None,
-                  on_b: Optional[Frame] = None) -> str:
-        """Fixed (weld): the points coincide and the joint angle stays as it starts. 3 eq."""
-        return self.add("fixed", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
-
-    def add_distance(self, name: str, *, body_a: str, body_b: str, point_a: Vector = (0, 0),
-                     point_b: Vector = (0, 0), length: float = 0.0) -> str:
-        """Distance (massless rod): the points keep their distance (length <= 0: the initial
-        one). 1 equation."""
-        return self.add("distance", name=name, body_a=body_a, point_a=point_a, body_b=body_b,
-                        point_b=point_b, length=length)
-
-    def add_revolute_driver(self, name: str, motion: Mapping[str, Any],
-                            joint: Optional[str] = None, **bodies_and_frames: Any) -> str:
-        """The joint angle (b's angle minus a's, from the axes) follows motion g(t). Give
-        `joint` (a revolute joint's name) or body_a, body_b and optionally on_a, on_b. 1 eq."""
-        params = dict(name=name, motion=motion, **bodies_and_frames)
-        if joint is not None:
-            params["joint"] = joint
-        return self.add("revolute_driver", **params)
-
-    def add_translational_driver(self, name: str, motion: Mapping[str, Any],
-                                 joint: Optional[str] = None, **bodies_and_frames: Any) -> str:
-        """The slide of b's point along a's axis, from a's point, follows motion g(t). Give
-        `joint` (a translational joint's name) or body_a, on_a, body_b, on_b. 1 equation."""
-        params = dict(name=name, motion=motion, **bodies_and_frames)
-        if joint is not None:
-            params["joint"] = joint
-        return self.add("translational_driver", **params)
-
-    def add_gravity(self, name: str, acceleration: Vector) -> str:
-        """Uniform gravity on every body (m/s^2, 2 numbers)."""
-        return self.add("gravity", name=name, acceleration=acceleration)
-
-    def add_point_force(self, name: str, body: str, force: Union[Vector, PlanarFunction],
-                        point: Vector = (0, 0), axes: str = "global") -> str:
-        """A force at a body point: constant (2 numbers), or force(t, body) -> 2 numbers, in
-        "global" or "body" axes."""
-        return self.add("point_force", name=name, body=body, point=point, force=force, axes=axes)
-
-    def add_point_torque(self, name: str, body: str,
-                         torque: Union[float, PlanarFunction]) -> str:
-        """A torque on a body (N m, counter-clockwise): a number, or torque(t, body) -> a
-        number."""
-        return self.add("point_torque", name=name, body=body, torque=torque)
-
-    def add_tsda(self, name: str, *, body_a: str, body_b: str, point_a: Vector = (0, 0),
-                 point_b: Vector = (0, 0), stiffness: float = 0.0, damping: float = 0.0,
-                 free_length: float = 0.0,
-                 actuator: Optional[Callable[[float, float, float], float]] = None) -> str:
-        """Translational spring-damper-actuator; tension k (L - free_length) + c L' +
-        actuator(t, L, L') pulls the points together."""
-        return self.add("tsda", name=name, body_a=body_a, point_a=point_a, body_b=body_b,
-                        point_b=point_b, stiffness=stiffness, damping=damping,
-                        free_length=free_length, actuator=actuator)
-
-    def add_rsda(self, name: str, *, body_a: str, body_b: str, on_a: Optional[Frame] = None,
-                 on_b: Optional[Frame] = None, stiffness: float = 0.0, damping: float = 0.0,
-                 free_angle: float = 0.0,
-                 actuator: Optional[Callable[[float, float, float], float]] = None) -> str:
-        """Rotational spring-damper-actuator on the joint angle theta (zero at the initial
-        pose unless both axes are given); torque on b -(k (theta - free_angle) + c theta') +
-        actuator(t, theta, theta'), and its opposite on a."""
-        return self.add("rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
-                        stiffness=stiffness, damping=damping, free_angle=free_angle,
-                        actuator=actuator)
-
-    def add_engine_gas_force(self, name: str, crank: str, piston: str, r: float = 0.04,
-                             L: float = 0.14, D: float = 0.08, C: float = 9.0,
-                             p_atm: float = 101325.0, kappa: float = 1.4,
-                             p_comb: float = 3.0e6) -> str:
-        """The engine's Otto-cycle gas force on the piston along y (shared/specs/engine.md),
-        with the crank angle read from the crank's angle. Events at each half turn."""
-        return self.add("engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D,
-                        C=C, p_atm=p_atm, kappa=kappa, p_comb=p_comb)
-
-    def add_user_force(self, name: str, bodies: Sequence[str],
-                       function: Callable[..., Any]) -> str:
-        """A force written in Python on one or two bodies: function(t, body_0[, body_1])
-        returns, per body, 3 numbers: the global force (x, y) at the centre of mass, then the
-        torque. The body views are refreshed before each call (copy them to keep them)."""
-        return self.add("user_force", name=name, bodies=list(bodies), function=function)
 
 
 def new_model(space: str = "spatial") -> BaseModel:

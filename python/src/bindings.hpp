@@ -99,6 +99,19 @@ class UserForceT {
   static constexpr int num_bodies = N;
   static constexpr int width = Space::dim + Space::nw;  // numbers per body
 
+  static constexpr std::array<Parameter, 3> parameter_list{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"bodies", "bodies", nullptr, "", "the one or two bodies it acts on"},
+      {"function", "callable", nullptr, "N, N m",
+       "function(t, body_0[, body_1]) -> per body the global force at the centre of mass, "
+       "then the global torque"},
+  }};
+  static constexpr ElementDescription description{
+      "user_force", "force",
+      "A force written in Python on one or two bodies (the body views are refreshed before "
+      "each call: copy them to keep them).",
+      parameter_list};
+
   UserForceT(std::string name, const std::array<BodyId, N>& bodies,
              std::shared_ptr<Callable<Space>> function)
       : name_(std::move(name)), bodies_(bodies), function_(std::move(function)) {}
@@ -180,8 +193,8 @@ static_assert(StatelessForce<SignalWatch<Spatial>> && StatelessForce<SignalWatch
 using EngineGasForce = engine::GasForce;
 using PlanarEngineGasForce = engine::planar::GasForce;
 
-/// The spatial model type of the bindings. Its element list and its element_type_names go
-/// together.
+/// The spatial model type of the bindings: every element type in it that describes itself can
+/// be added from Python (catalogue.hpp).
 using Model =
     sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
               sp::Fixed, sp::Distance, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
@@ -208,52 +221,6 @@ static_assert(CoversCatalogue<Model, sp::DefaultModel>::value,
 static_assert(CoversCatalogue<PlanarModel, pl::DefaultModel>::value,
               "the bindings' planar model lacks an element of odyn::planar::DefaultModel");
 
-/// Names of the element types, in the order of each model's element list.
-template <class M>
-struct ElementTypeNames;
-template <>
-struct ElementTypeNames<Model> {
-  static constexpr std::array<const char*, Model::num_types> value = {"revolute",
-                                                                      "translational",
-                                                                      "spherical",
-                                                                      "universal",
-                                                                      "cylindrical",
-                                                                      "fixed",
-                                                                      "distance",
-                                                                      "revolute_driver",
-                                                                      "translational_driver",
-                                                                      "gravity",
-                                                                      "point_force",
-                                                                      "point_torque",
-                                                                      "tsda",
-                                                                      "rsda",
-                                                                      "engine_gas_force",
-                                                                      "user_force",
-                                                                      "user_force",
-                                                                      "signal_watch"};
-};
-template <>
-struct ElementTypeNames<PlanarModel> {
-  static constexpr std::array<const char*, PlanarModel::num_types> value = {"revolute",
-                                                                            "translational",
-                                                                            "fixed",
-                                                                            "distance",
-                                                                            "revolute_driver",
-                                                                            "translational_driver",
-                                                                            "gravity",
-                                                                            "point_force",
-                                                                            "point_torque",
-                                                                            "tsda",
-                                                                            "rsda",
-                                                                            "engine_gas_force",
-                                                                            "user_force",
-                                                                            "user_force",
-                                                                            "signal_watch"};
-};
-static_assert(ElementTypeNames<Model>::value.back() != nullptr &&
-                  ElementTypeNames<PlanarModel>::value.back() != nullptr,
-              "a name for every element type");
-
 /// The model a Python odyn.Model (or odyn.PlanarModel) holds, and whether an analysis is
 /// running on it (while the GIL is released, another thread must not change it).
 template <class M>
@@ -272,15 +239,12 @@ struct ModelBox {
 using SpatialBox = ModelBox<Model>;
 using PlanarBox = ModelBox<PlanarModel>;
 
-/// Adds bodies and elements of the planar model (planar.cpp).
+/// Adds a body to the planar model (planar.cpp).
 void add_planar_body(PlanarBox& box, const py::dict& parameters);
-void add_planar_element(PlanarBox& box, const std::string& type, const py::dict& parameters);
 
 /// Helpers shared by the model-building units (module.cpp, planar.cpp).
 double number(const py::dict& d, const char* key);
 std::string text(const py::dict& d, const char* key);
-bool is_callable(const py::dict& d, const char* key);
-Axes axes(const py::dict& d);
 Motion motion(const py::dict& d, const std::string& what);
 std::function<double(double, double, double)> scalar_function3(py::object f,
                                                                const std::string& what);

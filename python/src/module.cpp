@@ -10,6 +10,7 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "catalogue.hpp"
 
 namespace odyn::python {
 
@@ -167,12 +168,6 @@ double number(const py::dict& d, const char* key) {
 std::string text(const py::dict& d, const char* key) {
   return d[key].cast<std::string>();
 }
-bool is_callable(const py::dict& d, const char* key) {
-  return d.contains(key) && PyCallable_Check(d[key].ptr());
-}
-Axes axes(const py::dict& d) {
-  return d.contains("axes") && text(d, "axes") == "body" ? Axes::body : Axes::global;
-}
 
 namespace {
 /// A scalar function of one or three numbers from a Python callable.
@@ -220,113 +215,6 @@ using Eigen::Vector3d;
 Vector3d vec3(const py::dict& d, const char* key) {
   return d[key].cast<Vector3d>();
 }
-std::string describe(const std::string& type, const std::string& name) {
-  return type + " '" + name + "'";
-}
-
-sp::JointFrame joint_frame(const py::dict& d, const char* key) {
-  const py::dict frame = d[key].cast<py::dict>();
-  sp::JointFrame out;
-  out.point = vec3(frame, "point");
-  out.axis = vec3(frame, "axis");
-  if (frame.contains("reference") && !frame["reference"].is_none())
-    out.reference = vec3(frame, "reference");
-  return out;
-}
-
-template <class Vector>
-std::function<Vector(double, const Spatial::Frame&)> frame_function(py::object f,
-                                                                    const std::string& what) {
-  auto callable = std::make_shared<Callable<Spatial>>(std::move(f), 1, what);
-  return [callable](double t, const Spatial::Frame& frame) {
-    const Spatial::Frame* frames[1] = {&frame};
-    Vector value;
-    py::gil_scoped_acquire gil;
-    read_numbers(callable->call_with_frames(t, frames), value.data(), 3, callable->what());
-    return value;
-  };
-}
-
-void add_element(SpatialBox& box, const std::string& type, const py::dict& d) {
-  if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
-  box.assembled = {};  // the model changes: assemble again
-  Model& model = box.model;
-  const std::string name = text(d, "name");
-  const std::string what = describe(type, name);
-  auto body = [&](const char* key) { return model.body(text(d, key)); };
-  auto pair = [&]<class Joint>(std::type_identity<Joint>) {
-    model.add(Joint(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                    joint_frame(d, "on_b")));
-  };
-  if (type == "revolute") return pair(std::type_identity<sp::Revolute>{});
-  if (type == "translational") return pair(std::type_identity<sp::Translational>{});
-  if (type == "universal") return pair(std::type_identity<sp::Universal>{});
-  if (type == "cylindrical") return pair(std::type_identity<sp::Cylindrical>{});
-  if (type == "fixed") return pair(std::type_identity<sp::Fixed>{});
-  if (type == "spherical")
-    return void(model.add(sp::Spherical(name, body("body_a"), vec3(d, "point_a"), body("body_b"),
-                                        vec3(d, "point_b"))));
-  if (type == "distance")
-    return void(model.add(sp::Distance(name, body("body_a"), vec3(d, "point_a"), body("body_b"),
-                                       vec3(d, "point_b"), number(d, "length"))));
-  if (type == "revolute_driver")
-    return void(
-        model.add(sp::RevoluteDriver(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                                     joint_frame(d, "on_b"), motion(d, what))));
-  if (type == "translational_driver")
-    return void(model.add(sp::TranslationalDriver(name, body("body_a"), joint_frame(d, "on_a"),
-                                                  body("body_b"), joint_frame(d, "on_b"),
-                                                  motion(d, what))));
-  if (type == "gravity") return void(model.add(sp::Gravity(name, vec3(d, "acceleration"))));
-  if (type == "point_force") {
-    if (is_callable(d, "force"))
-      return void(model.add(sp::PointForce(name, body("body"), vec3(d, "point"),
-                                           frame_function<Vector3d>(d["force"], what), axes(d))));
-    return void(
-        model.add(sp::PointForce(name, body("body"), vec3(d, "point"), vec3(d, "force"), axes(d))));
-  }
-  if (type == "point_torque") {
-    if (is_callable(d, "torque"))
-      return void(model.add(sp::PointTorque(name, body("body"),
-                                            frame_function<Vector3d>(d["torque"], what), axes(d))));
-    return void(model.add(sp::PointTorque(name, body("body"), vec3(d, "torque"), axes(d))));
-  }
-  if (type == "tsda") {
-    sp::Tsda::Parameters p{
-        number(d, "stiffness"), number(d, "damping"), number(d, "free_length"), {}};
-    if (is_callable(d, "actuator"))
-      p.actuator = scalar_function3(d["actuator"], what + " actuator");
-    return void(model.add(
-        sp::Tsda(name, body("body_a"), vec3(d, "point_a"), body("body_b"), vec3(d, "point_b"), p)));
-  }
-  if (type == "rsda") {
-    sp::Rsda::Parameters p{
-        number(d, "stiffness"), number(d, "damping"), number(d, "free_angle"), {}};
-    if (is_callable(d, "actuator"))
-      p.actuator = scalar_function3(d["actuator"], what + " actuator");
-    return void(model.add(sp::Rsda(name, body("body_a"), joint_frame(d, "on_a"), body("body_b"),
-                                   joint_frame(d, "on_b"), p)));
-  }
-  if (type == "engine_gas_force") {
-    engine::Parameters p;
-    p.r = number(d, "r"), p.L = number(d, "L"), p.D = number(d, "D"), p.C = number(d, "C");
-    p.p_atm = number(d, "p_atm"), p.kappa = number(d, "kappa"), p.p_comb = number(d, "p_comb");
-    return void(model.add(EngineGasForce(name, body("crank"), body("piston"), p)));
-  }
-  if (type == "user_force") {
-    const auto names = d["bodies"].cast<std::vector<std::string>>();
-    auto callable =
-        std::make_shared<Callable<Spatial>>(d["function"], static_cast<int>(names.size()), what);
-    if (names.size() == 1)
-      return void(model.add(UserForceT<Spatial, 1>(name, {model.body(names[0])}, callable)));
-    if (names.size() == 2)
-      return void(model.add(
-          UserForceT<Spatial, 2>(name, {model.body(names[0]), model.body(names[1])}, callable)));
-    throw ModelError(name, "a user force acts on one or two bodies");
-  }
-  throw ModelError(name, "unknown element type '" + type + "'");
-}
-
 void add_body(SpatialBox& box, const py::dict& d) {
   if (box.running) throw ModelError("model", "cannot change a model while an analysis runs");
   sp::Body body;
@@ -358,14 +246,48 @@ void bind_model(py::module_& m, const char* name, const char* doc, AddBody add_b
            [](const Box& b, const std::string& body) { return b.model.body(body).index; })
       .def("element_type", [](const Box& b, const std::string& element) {
         using M = typename Box::ModelType;
-        return std::string(ElementTypeNames<M>::value[b.model.locate(element).type]);
+        return std::string(Catalogue<M>::type_names[b.model.locate(element).type]);
       });
 }
 
 template <class M>
 py::object type_names() {
-  const auto& names = ElementTypeNames<M>::value;
+  const auto& names = Catalogue<M>::type_names;
   return py::cast(std::vector<std::string>(names.begin(), names.end()));
+}
+
+/// The descriptions of the element types a model type can add, as plain Python values: a list
+/// of {type, category, summary, parameters: [{name, kind, default (JSON text or None), unit,
+/// doc}]}.
+template <class M>
+py::list catalogue() {
+  py::list out;
+  for (const ElementDescription* d : Catalogue<M>::descriptions()) {
+    py::list parameters;
+    for (const Parameter& p : d->parameters) {
+      py::dict entry;
+      entry["name"] = p.name;
+      entry["kind"] = p.kind;
+      entry["default"] =
+          p.fallback == nullptr ? py::object(py::none()) : py::object(py::str(p.fallback));
+      entry["unit"] = p.unit;
+      entry["doc"] = p.doc;
+      parameters.append(entry);
+    }
+    py::dict element;
+    element["type"] = d->type;
+    element["category"] = d->category;
+    element["summary"] = d->summary;
+    element["parameters"] = parameters;
+    out.append(element);
+  }
+  return out;
+}
+
+py::list kinds() {
+  py::list out;
+  for (const ParameterKind& kind : parameter_kinds) out.append(py::make_tuple(kind.name, kind.doc));
+  return out;
 }
 
 }  // namespace
@@ -395,11 +317,14 @@ PYBIND11_MODULE(_core, m) {
   });
 
   bind_model<SpatialBox>(m, "Model", "The C++ spatial model (odyn.Model wraps it).", &add_body,
-                         &add_element);
+                         &add_element<SpatialBox>);
   bind_model<PlanarBox>(m, "PlanarModel", "The C++ planar model (odyn.PlanarModel wraps it).",
-                        &add_planar_body, &add_planar_element);
+                        &add_planar_body, &add_element<PlanarBox>);
   m.attr("element_types") = type_names<Model>();
   m.attr("planar_element_types") = type_names<PlanarModel>();
+  m.attr("element_catalogue") = catalogue<Model>();
+  m.attr("planar_element_catalogue") = catalogue<PlanarModel>();
+  m.attr("parameter_kinds") = kinds();
   bind_integrators(m);
   bind_spatial_analyses(m);
   bind_planar_analyses(m);

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
 
@@ -13,6 +14,18 @@ class GravityField {
  public:
   using Space = SpaceT;
   using Vector = typename Space::Vector;
+
+  static constexpr std::array<Parameter, 2> parameter_list{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"acceleration", "vector", nullptr, "m/s^2", "the acceleration of gravity"},
+  }};
+  static constexpr ElementDescription description{
+      "gravity", "force", "Uniform gravity: a force m g at every body's centre of mass.",
+      parameter_list};
+  template <class Reader>
+  static GravityField from_parameters(Reader& r) {
+    return GravityField(parameter<std::string>(r, "name"), parameter<Vector>(r, "acceleration"));
+  }
 
   GravityField(std::string name, const Vector& acceleration)
       : name_(std::move(name)), g_(acceleration) {

@@ -5,6 +5,7 @@
 #include <functional>
 #include <string>
 
+#include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
 
@@ -20,6 +21,28 @@ class PointForceT {
   using Frame = typename Space::Frame;
   using Function = std::function<Vector(double t, const Frame& body)>;
   static constexpr int num_bodies = 1;
+
+  static constexpr std::array<Parameter, 5> parameter_list{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"body", "body", nullptr, "", "the body it acts on"},
+      {"force", "vector_or_callable", nullptr, "N",
+       "the force: constant, or force(t, body) -> a vector"},
+      {"point", "vector", "0", "m", "where it acts, in body coordinates"},
+      {"axes", "axes", "\"global\"", "", "the axes the force is given in"},
+  }};
+  static constexpr ElementDescription description{
+      "point_force", "force", "A force at a body point, constant or a function of time and state.",
+      parameter_list};
+  template <class Reader>
+  static PointForceT from_parameters(Reader& r) {
+    const auto name = parameter<std::string>(r, "name");
+    const BodyId body = parameter<BodyId>(r, "body");
+    const auto point = parameter<Vector>(r, "point");
+    const Axes axes = parameter<Axes>(r, "axes");
+    if (parameter_is_function(r, "force"))
+      return PointForceT(name, body, point, parameter<Function>(r, "force"), axes);
+    return PointForceT(name, body, point, parameter<Vector>(r, "force"), axes);
+  }
 
   PointForceT(std::string name, BodyId body, const Vector& point, Function force,
               Axes axes = Axes::global)
@@ -66,6 +89,26 @@ class PointTorqueT {
   using Frame = typename Space::Frame;
   using Function = std::function<Angular(double t, const Frame& body)>;
   static constexpr int num_bodies = 1;
+
+  static constexpr std::array<Parameter, 4> parameter_list{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"body", "body", nullptr, "", "the body it acts on"},
+      {"torque", "angular_or_callable", nullptr, "N m",
+       "the torque: constant, or torque(t, body) -> one"},
+      {"axes", "axes", "\"global\"", "", "the axes the torque is given in (space only)"},
+  }};
+  static constexpr ElementDescription description{
+      "point_torque", "force", "A torque on a body, constant or a function of time and state.",
+      std::span<const Parameter>(parameter_list.data(), Space::nw == 3 ? 4 : 3)};
+  template <class Reader>
+  static PointTorqueT from_parameters(Reader& r) {
+    const auto name = parameter<std::string>(r, "name");
+    const BodyId body = parameter<BodyId>(r, "body");
+    const Axes axes = Space::nw == 3 ? parameter<Axes>(r, "axes") : Axes::global;
+    if (parameter_is_function(r, "torque"))
+      return PointTorqueT(name, body, parameter<Function>(r, "torque"), axes);
+    return PointTorqueT(name, body, parameter<Angular>(r, "torque"), axes);
+  }
 
   PointTorqueT(std::string name, BodyId body, Function torque, Axes axes = Axes::global)
       : name_(std::move(name)), bodies_{body}, torque_(std::move(torque)), axes_(axes) {

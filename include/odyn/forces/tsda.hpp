@@ -9,6 +9,7 @@
 
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/core/parameter_blocks.hpp"
 
 namespace odyn {
 
@@ -28,6 +29,19 @@ class TsdaT {
     double free_length = 0.0;  // m
     Actuator actuator = {};    // extra tension, N (optional)
   };
+
+  static constexpr std::array<Parameter, 9> parameter_list =
+      join(parameters::point_pair, parameters::translational_spring);
+  static constexpr ElementDescription description{
+      "tsda", "force",
+      "Translational spring-damper-actuator: the tension k (L - free_length) + c L' + "
+      "actuator(t, L, L') pulls the points together.",
+      parameter_list};
+  template <class Reader>
+  static TsdaT from_parameters(Reader& r) {
+    return parameters::from_point_pair<TsdaT, Vector>(
+        r, parameters::spring_law<Parameters>(r, "free_length"));
+  }
 
   TsdaT(std::string name, BodyId body_a, const Vector& point_a, BodyId body_b,
         const Vector& point_b, Parameters parameters)

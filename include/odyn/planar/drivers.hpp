@@ -18,6 +18,17 @@ namespace odyn::planar {
 class RevoluteDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
+  static constexpr ElementDescription description{
+      "revolute_driver", "driver",
+      "Revolute driver: the joint angle (b's angle minus a's, from the axes) follows g(t). 1 "
+      "equation.",
+      parameters::driver};
+  /// From two bodies and their frames (a front end resolves `joint` into them).
+  template <class Reader>
+  static RevoluteDriver from_parameters(Reader& r) {
+    return parameters::from_frame_pair<RevoluteDriver, JointFrame>(r,
+                                                                   parameter<Motion>(r, "motion"));
+  }
 
   RevoluteDriver(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
                  const JointFrame& on_b, Motion motion)
@@ -51,6 +62,17 @@ static_assert(Constraint<RevoluteDriver>);
 class TranslationalDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
+  static constexpr ElementDescription description{
+      "translational_driver", "driver",
+      "Translational driver: the slide of b's point along a's axis, from a's point, follows g(t). "
+      "1 equation.",
+      parameters::driver};
+  /// From two bodies and their frames (a front end resolves `joint` into them).
+  template <class Reader>
+  static TranslationalDriver from_parameters(Reader& r) {
+    return parameters::from_frame_pair<TranslationalDriver, JointFrame>(
+        r, parameter<Motion>(r, "motion"));
+  }
 
   TranslationalDriver(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
                       const JointFrame& on_b, Motion motion)

@@ -12,6 +12,14 @@ class Fixed : public PairJoint {
  public:
   static constexpr int num_equations = 3;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{"fixed", "joint",
+                                                  "Fixed (weld): the joint points coincide and the "
+                                                  "joint angle stays as it starts. 3 equations.",
+                                                  parameters::frame_pair};
+  template <class Reader>
+  static Fixed from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Fixed, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 0;
 
   /// As a tree joint: the child moves with its parent.

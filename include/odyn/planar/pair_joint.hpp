@@ -16,8 +16,10 @@
 #include <string>
 #include <utility>
 
+#include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/core/parameter_blocks.hpp"
 #include "odyn/core/planar.hpp"
 
 namespace odyn::planar {

@@ -12,6 +12,15 @@ class Revolute : public PairJoint {
  public:
   static constexpr int num_equations = 2;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "revolute", "joint",
+      "Revolute (pin): the joint points coincide; its angle is what a revolute driver prescribes. "
+      "2 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Revolute from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Revolute, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 1;
 
   /// As a tree joint: the child turns about the parent's point.

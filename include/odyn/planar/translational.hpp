@@ -16,6 +16,15 @@ class Translational : public PairJoint {
  public:
   static constexpr int num_equations = 2;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "translational", "joint",
+      "Translational (slider): b's point moves along the line through a's point with a's axis, "
+      "without turning. 2 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Translational from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Translational, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 1;
 
   /// As a tree joint: the child slides along a's axis, which keeps its direction in the parent's

@@ -12,6 +12,15 @@ class Cylindrical : public PairJoint {
  public:
   static constexpr int num_equations = 4;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "cylindrical", "joint",
+      "Cylindrical: the axes stay parallel and b's point stays on a's axis; b slides along and "
+      "turns about it. 4 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Cylindrical from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Cylindrical, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 2;
 
   /// As a tree joint: the child slides along the parent's axis and turns about it.

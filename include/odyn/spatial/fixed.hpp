@@ -11,6 +11,14 @@ class Fixed : public PairJoint {
  public:
   static constexpr int num_equations = 6;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "fixed", "joint",
+      "Fixed (weld): the joint frames of the two bodies stay together. 6 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Fixed from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Fixed, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 0;
 
   /// As a tree joint: the child is carried rigidly.

@@ -5,7 +5,9 @@
 #include <string>
 #include <utility>
 
+#include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
+#include "odyn/core/parameter_blocks.hpp"
 #include "odyn/core/spatial.hpp"
 #include "odyn/spatial/joint_frame.hpp"
 

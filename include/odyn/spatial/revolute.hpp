@@ -11,6 +11,14 @@ class Revolute : public PairJoint {
  public:
   static constexpr int num_equations = 5;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "revolute", "joint",
+      "Revolute (hinge): the joint points coincide and the axes stay parallel. 5 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Revolute from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Revolute, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 1;
 
   /// As a tree joint: the child turns about the parent's axis, through the parent's point.

@@ -29,6 +29,19 @@ class Rsda : public PairJoint {
     double angle = 0.0;  // unwrapped angle at the last accepted step
   };
 
+  static constexpr std::array<Parameter, 9> parameter_list =
+      join(parameters::frame_pair, parameters::rotational_spring);
+  static constexpr ElementDescription description{
+      "rsda", "force",
+      "Rotational spring-damper-actuator about a's axis: torque on b -(k (theta - free_angle) + c "
+      "theta') + actuator(t, theta, theta').",
+      parameter_list};
+  template <class Reader>
+  static Rsda from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Rsda, JointFrame>(
+        r, parameters::spring_law<Parameters>(r, "free_angle"));
+  }
+
   Rsda(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
        const JointFrame& on_b, Parameters parameters)
       : PairJoint(std::move(name), body_a, on_a, body_b, on_b), p_(std::move(parameters)) {

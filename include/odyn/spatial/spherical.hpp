@@ -10,6 +10,13 @@ namespace odyn::spatial {
 class Spherical : public PairJoint {
  public:
   static constexpr int num_equations = 3;
+  static constexpr ElementDescription description{
+      "spherical", "joint", "Spherical (ball): the two points coincide. 3 equations.",
+      parameters::point_pair};
+  template <class Reader>
+  static Spherical from_parameters(Reader& r) {
+    return parameters::from_point_pair<Spherical, Eigen::Vector3d>(r);
+  }
 
   Spherical(std::string name, BodyId body_a, const Eigen::Vector3d& point_a, BodyId body_b,
             const Eigen::Vector3d& point_b)

@@ -12,6 +12,14 @@ class Translational : public PairJoint {
  public:
   static constexpr int num_equations = 5;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "translational", "joint",
+      "Translational (prismatic): b slides along a's axis without turning. 5 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Translational from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Translational, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 1;
 
   /// As a tree joint: the child slides along the parent's axis.

@@ -14,6 +14,15 @@ class Universal : public PairJoint {
  public:
   static constexpr int num_equations = 4;
   using PairJoint::PairJoint;
+  static constexpr ElementDescription description{
+      "universal", "joint",
+      "Universal (Cardan): the points coincide and the cross's two axes, one on each body, stay "
+      "perpendicular. 4 equations.",
+      parameters::frame_pair};
+  template <class Reader>
+  static Universal from_parameters(Reader& r) {
+    return parameters::from_frame_pair<Universal, JointFrame>(r);
+  }
   static constexpr int degrees_of_freedom = 2;
 
   /// As a tree joint: the child turns about the parent's axis, then about its own, both through

@@ -1,0 +1,225 @@
+"""Writes what comes from the element descriptions of the compiled core: the ``add_*`` methods of
+`odyn.Model` and `odyn.PlanarModel` (python/odyn/_elements.py) and the element reference
+(docs/elements.md).
+
+    python -m odyn._generate [--root REPOSITORY] [--check]
+
+Each element type describes its parameters once, next to its C++ blocks (see
+include/odyn/core/description.hpp); this script turns those descriptions into Python source and
+Markdown. --check writes nothing and fails if a file differs from what it would write (the test
+suite runs it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any, Dict, List, Mapping, Tuple
+
+from . import _schema
+
+SPACES = {"spatial": ("SpatialElements", "odyn.Model"),
+          "planar": ("PlanarElements", "odyn.PlanarModel")}
+
+#: The annotation of each kind, per space.
+_ANNOTATIONS: Dict[str, Tuple[str, str]] = {
+    "name": ("str", "str"),
+    "body": ("str", "str"),
+    "bodies": ("Sequence[str]", "Sequence[str]"),
+    "joint": ("str", "str"),
+    "vector": ("Vector", "Vector"),
+    "frame": ("Frame", "Frame"),
+    "number": ("float", "float"),
+    "nonnegative": ("float", "float"),
+    "positive": ("float", "float"),
+    "axes": ("str", "str"),
+    "motion": ("Mapping[str, Any]", "Mapping[str, Any]"),
+    "vector_or_callable": ("Union[Vector, FrameFunction]", "Union[Vector, PlanarFunction]"),
+    "angular_or_callable": ("Union[Vector, FrameFunction]", "Union[float, PlanarFunction]"),
+    "optional_callable": ("Callable[[float, float, float], float]",
+                          "Callable[[float, float, float], float]"),
+    "callable": ("Callable[..., Any]", "Callable[..., Any]"),
+}
+
+
+def _python_default(kind: str, text: str, dim: int) -> str:
+    value = json.loads(text)
+    if value is None:
+        return "None"
+    if kind == "vector" and value == 0:
+        return "(" + ", ".join(["0"] * dim) + ")"
+    if kind in ("number", "nonnegative", "positive"):
+        return repr(float(value))
+    return repr(value)
+
+
+def _signature(parameters: List[Mapping[str, Any]], space: str) -> str:
+    """Positional parameters until the first with a default; keyword-only from there on (so
+    that required ones may follow optional ones, as in a description's order)."""
+    dim = 3 if space == "spatial" else 2
+    index = 0 if space == "spatial" else 1
+    out = ["self"]
+    keyword_only = False
+    for p in parameters:
+        annotation = _ANNOTATIONS[p["kind"]][index]
+        if p["default"] is None:
+            out.append(f"{p['name']}: {annotation}")
+            continue
+        if not keyword_only:
+            out.append("*")
+            keyword_only = True
+        default = _python_default(p["kind"], p["default"], dim)
+        if default == "None":
+            annotation = f"Optional[{annotation}]"
+        out.append(f"{p['name']}: {annotation} = {default}")
+    return ", ".join(out)
+
+
+def _wrap(text: str, indent: str, width: int = 99) -> List[str]:
+    lines: List[str] = []
+    line = indent
+    for word in text.split():
+        if len(line) + 1 + len(word) > width and line.strip():
+            lines.append(line)
+            line = indent
+        line = f"{line} {word}" if line.strip() else indent + word
+    if line.strip():
+        lines.append(line)
+    return lines
+
+
+def _method(element: Mapping[str, Any], space: str) -> List[str]:
+    name = "add_" + element["type"]
+    head = f"    def {name}({_signature(element['parameters'], space)}) -> str:"
+    lines = []
+    if len(head) <= 99:
+        lines.append(head)
+    else:
+        args = _signature(element["parameters"], space).split(", ")
+        lines.append(f"    def {name}(")
+        line = "            "
+        for i, arg in enumerate(args):
+            piece = arg + ("," if i + 1 < len(args) else ") -> str:")
+            if len(line) + 1 + len(piece) > 99 and line.strip():
+                lines.append(line)
+                line = "            "
+            line = f"{line} {piece}" if line.strip() else line + piece
+        lines.append(line)
+    lines.append('        """' + element["summary"].replace('"', "'"))
+    lines[-1:] = _wrap(lines[-1].strip(), "        ")
+    lines.append("")
+    for p in element["parameters"]:
+        unit = f" ({p['unit']})" if p["unit"] else ""
+        lines += _wrap(f"{p['name']}{unit}: {p['doc']}.", "        ")
+    lines.append('        """')
+    call = ", ".join(f"{p['name']}={p['name']}" for p in element["parameters"])
+    statement = f'        return self._add_given("{element["type"]}", {call})'
+    if len(statement) <= 99:
+        lines.append(statement)
+    else:
+        lines.append("        return self._add_given(")
+        lines += _wrap(f'"{element["type"]}", {call})', "            ")
+    return lines
+
+
+def elements_source() -> str:
+    """The source of python/odyn/_elements.py."""
+    out = [
+        "# Generated by `python -m odyn._generate` from the element descriptions of the compiled",
+        "# core (each element's C++ header); do not edit. tests/python/test_catalogue.py checks",
+        "# that it is current.",
+        '"""The ``add_*`` methods of `odyn.Model` and `odyn.PlanarModel`: one per element type."""',
+        "",
+        "from __future__ import annotations",
+        "",
+        "from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Sequence, Union",
+        "",
+        "if TYPE_CHECKING:",
+        "    from .model import Frame, FrameFunction, PlanarFunction, Vector",
+        "",
+        "",
+        "class _Adds:",
+        "    def _add_given(self, type: str, **params: Any) -> str:",
+        "        raise NotImplementedError",
+    ]
+    for space, (cls, model) in SPACES.items():
+        out += ["", "", f"class {cls}(_Adds):",
+                f'    """The element types of {model}, each added by its own method."""']
+        for element in _schema.DESCRIPTIONS[space].values():
+            out.append("")
+            out += _method(element, space)
+    return "\n".join(out) + "\n"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def elements_markdown() -> str:
+    """The source of docs/elements.md."""
+    out = [
+        "# Elements",
+        "",
+        "<!-- Generated by `python -m odyn._generate` from the element descriptions of the "
+        "compiled core; do not edit. -->",
+        "",
+        "Every element type describes its parameters once, next to its C++ blocks "
+        "(`include/odyn/core/description.hpp`); this page, the Python `add_*` methods and the "
+        "scene-file checks all come from those descriptions. In Python, "
+        "`model.add_<type>(name, ...)` or `model.add(\"<type>\", ...)`; in a scene file, an entry "
+        "of `joints`, `drivers` or `forces` with `\"type\": \"<type>\"` and the same parameters. "
+        "A parameter without a default is required; an unknown one is refused with the list of "
+        "valid ones.",
+        "",
+        "## Parameter kinds",
+        "",
+        "| kind | value |",
+        "|---|---|",
+    ]
+    out += [f"| `{kind}` | {_cell(doc)} |" for kind, doc in _schema.KIND_DOCS.items()]
+    for space in SPACES:
+        out += ["", f"## {space.capitalize()} elements", "",
+                "| type | category | what it does |", "|---|---|---|"]
+        for t, element in _schema.DESCRIPTIONS[space].items():
+            out.append(f"| [`{t}`](#{space}-{t.replace('_', '-')}) | {element['category']} | "
+                       f"{_cell(element['summary'])} |")
+        for t, element in _schema.DESCRIPTIONS[space].items():
+            out += ["", f"### {space}: {t}", "", element["summary"], "",
+                    "| parameter | kind | default | unit | meaning |", "|---|---|---|---|---|"]
+            for p in element["parameters"]:
+                default = "required" if p["default"] is None else f"`{p['default']}`"
+                out.append(f"| `{p['name']}` | {p['kind']} | {default} | {p['unit']} | "
+                           f"{_cell(p['doc'])} |")
+    return "\n".join(out) + "\n"
+
+
+def outputs(root: Path) -> Dict[Path, str]:
+    return {root / "python" / "odyn" / "_elements.py": elements_source(),
+            root / "docs" / "elements.md": elements_markdown()}
+
+
+def main(argv: List[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python -m odyn._generate", description=__doc__)
+    parser.add_argument("--root", default=".", help="the repository (default: .)")
+    parser.add_argument("--check", action="store_true", help="fail if a file is not current")
+    args = parser.parse_args(argv)
+    stale = []
+    for path, text in outputs(Path(args.root)).items():
+        current = path.read_text() if path.exists() else None
+        if current == text:
+            continue
+        if args.check:
+            stale.append(str(path))
+        else:
+            path.write_text(text)
+            print(f"wrote {path}")
+    if stale:
+        print("not current (run python -m odyn._generate): " + ", ".join(stale), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
