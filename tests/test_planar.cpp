@@ -89,6 +89,10 @@ pl::Distance make_joint(const Scene& s, BodyId a, BodyId b) {
   return pl::Distance("rod", a, s.on_a.point, b, s.on_b.point, 0.8);
 }
 template <>
+pl::InLine make_joint(const Scene& s, BodyId a, BodyId b) {
+  return pl::InLine("pin in slot", a, s.on_a, b, s.on_b);
+}
+template <>
 pl::RevoluteDriver make_joint(const Scene& s, BodyId a, BodyId b) {
   return pl::RevoluteDriver("angle driver", a, s.on_a, b, s.on_b, harmonic_motion());
 }
@@ -197,8 +201,8 @@ void check_against_differences(const Scene& s) {
 }  // namespace
 
 TEMPLATE_TEST_CASE("planar constraint blocks match finite differences", "[planar][joints]",
-                   pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::RevoluteDriver,
-                   pl::TranslationalDriver) {
+                   pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
+                   pl::RevoluteDriver, pl::TranslationalDriver) {
   for (std::uint32_t seed = 1; seed <= 6; ++seed) {
     check_against_differences<TestType>(make_scene(seed, false));
     check_against_differences<TestType>(make_scene(seed + 100, true));

@@ -10,6 +10,7 @@
 #include "odyn/planar/distance.hpp"
 #include "odyn/planar/drivers.hpp"
 #include "odyn/planar/fixed.hpp"
+#include "odyn/planar/joint_primitives.hpp"
 #include "odyn/planar/revolute.hpp"
 #include "odyn/planar/rsda.hpp"
 #include "odyn/planar/translational.hpp"
@@ -26,7 +27,7 @@ template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every planar element type of the library (what scripting uses).
-using DefaultModel = Model<Revolute, Translational, Fixed, Distance, RevoluteDriver,
+using DefaultModel = Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver,
                            TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
 
 }  // namespace odyn::planar

@@ -10,6 +10,7 @@
 #include "odyn/spatial/distance.hpp"
 #include "odyn/spatial/drivers.hpp"
 #include "odyn/spatial/fixed.hpp"
+#include "odyn/spatial/joint_primitives.hpp"
 #include "odyn/spatial/revolute.hpp"
 #include "odyn/spatial/rsda.hpp"
 #include "odyn/spatial/spherical.hpp"
@@ -29,7 +30,8 @@ using Model = odyn::Model<Body, Elements...>;
 
 /// Every spatial element type of the library (what scripting uses).
 using DefaultModel =
-    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance,
-          RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
+    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
+          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, RevoluteDriver,
+          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
 
 }  // namespace odyn::spatial

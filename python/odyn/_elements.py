@@ -121,6 +121,94 @@ class SpatialElements(_Adds):
             "distance", name=name, body_a=body_a, point_a=point_a, body_b=body_b, point_b=point_b,
             length=length)
 
+    def add_planar(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """Planar joint: b's point stays in a's plane (normal a's axis) and the axes stay parallel;
+        b slides in the plane and turns about its normal. 3 equations.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "planar", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_inline(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """In-line primitive: b's point stays on the line through a's point along a's axis. 2
+        equations.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "inline", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_inplane(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """In-plane primitive: b's point stays in the plane through a's point normal to a's axis. 1
+        equation.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "inplane", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_orientation(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """Orientation primitive: b's frame keeps a's orientation (axes aligned, references as
+        given or as at the start); b translates freely. 3 equations.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "orientation", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_parallel_axes(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """Parallel-axes primitive: b's axis stays parallel to a's. 2 equations.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "parallel_axes", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_perpendicular(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """Perpendicular primitive: b's axis stays perpendicular to a's. 1 equation.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "perpendicular", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
     def add_revolute_driver(
             self, name: str, motion: Mapping[str, Any], *, joint: Optional[str] = None,
             body_a: Optional[str] = None, on_a: Optional[Frame] = None,
@@ -259,7 +347,8 @@ class SpatialElements(_Adds):
             p_atm=p_atm, kappa=kappa, p_comb=p_comb)
 
     def add_user_force(
-            self, name: str, bodies: Sequence[str], function: Callable[..., Any]) -> str:
+            self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            difference_jacobians: bool = True) -> str:
         """A force written in Python on one or two bodies (the body views are refreshed before each
         call: copy them to keep them).
 
@@ -267,8 +356,12 @@ class SpatialElements(_Adds):
         bodies: the one or two bodies it acts on.
         function (N, N m): function(t, body_0[, body_1]) -> per body the global force at the centre
         of mass, then the global torque.
+        difference_jacobians: give implicit integrators the force's stiffness and damping by
+        central differences (12 calls per body and Newton matrix); false: none.
         """
-        return self._add_given("user_force", name=name, bodies=bodies, function=function)
+        return self._add_given(
+            "user_force", name=name, bodies=bodies, function=function,
+            difference_jacobians=difference_jacobians)
 
 
 class PlanarElements(_Adds):
@@ -334,6 +427,21 @@ class PlanarElements(_Adds):
         return self._add_given(
             "distance", name=name, body_a=body_a, point_a=point_a, body_b=body_b, point_b=point_b,
             length=length)
+
+    def add_inline(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """In-line primitive: b's point stays on the line through a's point along a's axis (a pin
+        in a slot). 1 equation.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+        """
+        return self._add_given(
+            "inline", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
 
     def add_revolute_driver(
             self, name: str, motion: Mapping[str, Any], *, joint: Optional[str] = None,
@@ -471,7 +579,8 @@ class PlanarElements(_Adds):
             p_atm=p_atm, kappa=kappa, p_comb=p_comb)
 
     def add_user_force(
-            self, name: str, bodies: Sequence[str], function: Callable[..., Any]) -> str:
+            self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            difference_jacobians: bool = True) -> str:
         """A force written in Python on one or two bodies (the body views are refreshed before each
         call: copy them to keep them).
 
@@ -479,5 +588,9 @@ class PlanarElements(_Adds):
         bodies: the one or two bodies it acts on.
         function (N, N m): function(t, body_0[, body_1]) -> per body the global force at the centre
         of mass, then the global torque.
+        difference_jacobians: give implicit integrators the force's stiffness and damping by
+        central differences (12 calls per body and Newton matrix); false: none.
         """
-        return self._add_given("user_force", name=name, bodies=bodies, function=function)
+        return self._add_given(
+            "user_force", name=name, bodies=bodies, function=function,
+            difference_jacobians=difference_jacobians)

@@ -32,6 +32,7 @@ _ANNOTATIONS: Dict[str, Tuple[str, str]] = {
     "vector": ("Vector", "Vector"),
     "frame": ("Frame", "Frame"),
     "number": ("float", "float"),
+    "flag": ("bool", "bool"),
     "nonnegative": ("float", "float"),
     "positive": ("float", "float"),
     "axes": ("str", "str"),

@@ -80,6 +80,12 @@ def check_choice(x: Any, where: str, choices: Sequence[str]) -> str:
     return x
 
 
+def check_flag(x: Any, where: str) -> bool:
+    if not isinstance(x, bool):
+        fail(where, f"expected true or false, got {_describe(x)}")
+    return x
+
+
 def check_callable(x: Any, where: str) -> Callable:
     if not callable(x):
         fail(where, f"expected a Python callable, got {_describe(x)}")
@@ -216,6 +222,7 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
         "vector": lambda x, w, b: check_vector(x, w, dim),
         "frame": lambda x, w, b: frame({} if x is None else x, w),
         "number": lambda x, w, b: check_number(x, w),
+        "flag": lambda x, w, b: check_flag(x, w),
         "nonnegative": lambda x, w, b: check_number(x, w, minimum=0.0),
         "positive": lambda x, w, b: check_number(x, w, positive=True),
         "axes": lambda x, w, b: check_choice(x, w, ("global", "body")),

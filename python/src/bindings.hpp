@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <odyn/core/difference_jacobians.hpp>
 #include <odyn/odyn.hpp>
 
 #include "engine_model.hpp"  // examples/: the engine's gas force, exposed to scenes
@@ -99,12 +100,15 @@ class UserForceT {
   static constexpr int num_bodies = N;
   static constexpr int width = Space::dim + Space::nw;  // numbers per body
 
-  static constexpr std::array<Parameter, 3> parameter_list{{
+  static constexpr std::array<Parameter, 4> parameter_list{{
       {"name", "name", nullptr, "", "the element's name"},
       {"bodies", "bodies", nullptr, "", "the one or two bodies it acts on"},
       {"function", "callable", nullptr, "N, N m",
        "function(t, body_0[, body_1]) -> per body the global force at the centre of mass, "
        "then the global torque"},
+      {"difference_jacobians", "flag", "true", "",
+       "give implicit integrators the force's stiffness and damping by central differences "
+       "(12 calls per body and Newton matrix); false: none"},
   }};
   static constexpr ElementDescription description{
       "user_force", "force",
@@ -113,8 +117,11 @@ class UserForceT {
       parameter_list};
 
   UserForceT(std::string name, const std::array<BodyId, N>& bodies,
-             std::shared_ptr<Callable<Space>> function)
-      : name_(std::move(name)), bodies_(bodies), function_(std::move(function)) {}
+             std::shared_ptr<Callable<Space>> function, bool difference_jacobians = true)
+      : name_(std::move(name)),
+        bodies_(bodies),
+        function_(std::move(function)),
+        difference_jacobians_(difference_jacobians) {}
 
   const std::string& name() const { return name_; }
   const std::array<BodyId, N>& bodies() const { return bodies_; }
@@ -135,10 +142,22 @@ class UserForceT {
     }
   }
 
+  /// Stiffness and damping for implicit integrators' Newton matrices, by central differences
+  /// of the Python function (or none, if the user turned them off).
+  void jacobians(const ElementInput<Space, N>& in, ForceBlocks<Space, N>& out) const {
+    if (difference_jacobians_) {
+      difference_jacobians(*this, in, out);
+    } else {
+      out.stiffness.setZero();
+      out.damping.setZero();
+    }
+  }
+
  private:
   std::string name_;
   std::array<BodyId, N> bodies_;
   std::shared_ptr<Callable<Space>> function_;
+  bool difference_jacobians_ = true;
 };
 static_assert(StatelessForce<UserForceT<Spatial, 1>> && StatelessForce<UserForceT<Spatial, 2>>);
 static_assert(StatelessForce<UserForceT<Planar, 1>> && StatelessForce<UserForceT<Planar, 2>>);
@@ -197,16 +216,17 @@ using PlanarEngineGasForce = engine::planar::GasForce;
 /// be added from Python (catalogue.hpp).
 using Model =
     sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
-              sp::Fixed, sp::Distance, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
-              sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce,
+              sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane, sp::Orientation,
+              sp::ParallelAxes, sp::Perpendicular, sp::RevoluteDriver, sp::TranslationalDriver,
+              sp::Gravity, sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce,
               UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
 using PlanarModel =
-    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::RevoluteDriver,
-              pl::TranslationalDriver, pl::Gravity, pl::PointForce, pl::PointTorque, pl::Tsda,
-              pl::Rsda, PlanarEngineGasForce, UserForceT<Planar, 1>, UserForceT<Planar, 2>,
-              SignalWatch<Planar>>;
+    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
+              pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity, pl::PointForce,
+              pl::PointTorque, pl::Tsda, pl::Rsda, PlanarEngineGasForce, UserForceT<Planar, 1>,
+              UserForceT<Planar, 2>, SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
 /// DefaultModel): a new element in the library fails this check until the bindings have it.

@@ -61,6 +61,8 @@ class DictReader {
       return value.cast<std::vector<std::string>>();
     } else if constexpr (std::is_same_v<T, double>) {
       return value.cast<double>();
+    } else if constexpr (std::is_same_v<T, bool>) {
+      return value.cast<bool>();
     } else if constexpr (std::is_same_v<T, BodyId>) {
       return model_.body(value.cast<std::string>());
     } else if constexpr (std::is_same_v<T, Axes>) {
@@ -236,6 +238,8 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
     const auto name = parameter<std::string>(reader, "name");
     const auto bodies = reader.template get<std::vector<std::string>>("bodies");
     py::object function = reader.template get<py::object>("function");
+    const bool differences =
+        !values.contains("difference_jacobians") || parameter<bool>(reader, "difference_jacobians");
     reader.refuse_unread();
     const std::string what = "user_force '" + name + "'";
     if (bodies.size() != 1 && bodies.size() != 2)
@@ -243,10 +247,10 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
     auto callable = std::make_shared<Callable<Space>>(std::move(function),
                                                       static_cast<int>(bodies.size()), what);
     if (bodies.size() == 1)
-      box.model.add(UserForceT<Space, 1>(name, {box.model.body(bodies[0])}, callable));
+      box.model.add(UserForceT<Space, 1>(name, {box.model.body(bodies[0])}, callable, differences));
     else
       box.model.add(UserForceT<Space, 2>(
-          name, {box.model.body(bodies[0]), box.model.body(bodies[1])}, callable));
+          name, {box.model.body(bodies[0]), box.model.body(bodies[1])}, callable, differences));
   }
 };
 

@@ -242,6 +242,19 @@ def test_python_spring_damper_matches_the_cpp_tsda(kind):
     np.testing.assert_allclose(py.v, ref.v, atol=1e-7)
 
 
+def test_python_force_gives_newton_its_stiffness_by_differences():
+    # A stiff spring (k h^2 / m = 3 at h = 1e-3) written in Python: generalized-alpha's Newton
+    # iteration needs its stiffness, which odyn takes by central differences of the function
+    # (the default). With it the run is the C++ spring's, which gives its exact blocks.
+    k = 3e6
+    ref = odyn.simulate(spring_on_rail("tsda", k=k), t_end=0.05, step=1e-3,
+                        output_interval=0.01, integrator="generalized-alpha")
+    py = odyn.simulate(spring_on_rail("user_force", k=k), t_end=0.05, step=1e-3,
+                       output_interval=0.01, integrator="generalized-alpha")
+    np.testing.assert_allclose(py.q, ref.q, atol=1e-9)
+    np.testing.assert_allclose(py.v, ref.v, atol=1e-6)
+
+
 def test_two_body_user_force_matches_the_cpp_tsda():
     def model(python):
         m = odyn.Model()
@@ -299,6 +312,72 @@ def test_python_damping_torque_matches_the_cpp_rsda():
     # omega = exp(-c t / J)
     np.testing.assert_allclose(py.body("rotor").angular_velocity[:, 2], np.exp(-0.3 * py.t),
                                atol=1e-6)
+
+
+def test_primitives_compose_the_translational_joint():
+    # in-line + orientation = translational: the same slide down the 45 degree guide.
+    covers("inline", "orientation")
+    axis = [1, 0, -1]
+    m = odyn.Model()
+    m.add_body(name="block", mass=2.0, inertia=[0.1, 0.1, 0.1])
+    for kind in ("inline", "orientation"):
+        m.add(kind, name=kind, body_a="ground", on_a=odyn.frame([0, 0, 0], axis),
+              body_b="block", on_b=odyn.frame([0, 0, 0], axis))
+    m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+    r = odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.5)
+    s = G * r.t**2 / (2 * math.sqrt(2))
+    expected = np.column_stack([s / math.sqrt(2), 0 * s, -s / math.sqrt(2)])
+    np.testing.assert_allclose(r.body("block").position, expected, atol=1e-9)
+    # The line carries the normal force m g cos 45 along (1, 0, 1)/sqrt 2; the orientation
+    # primitive carries no force, only a torque (here none).
+    np.testing.assert_allclose(r.reaction("inline").force[-1], [G, 0, G], atol=1e-8)
+    np.testing.assert_allclose(r.reaction("orientation").force[-1], [0, 0, 0], atol=1e-8)
+    np.testing.assert_allclose(r.reaction("orientation").torque[-1], [0, 0, 0], atol=1e-8)
+
+
+@pytest.mark.parametrize("composed", [False, True])
+def test_planar_joint_and_its_primitives_slide_a_spinning_block_down_a_slope(composed):
+    # planar = in-plane + parallel axes. On a plane tilted by alpha about x, the block slides
+    # with g sin(alpha) down the slope and keeps its spin about the normal.
+    covers("planar", "inplane", "parallel_axes")
+    alpha, omega = 0.3, 2.0
+    n = [0, math.sin(alpha), math.cos(alpha)]
+    m = odyn.Model()
+    tilt = [math.cos(-alpha / 2), math.sin(-alpha / 2), 0, 0]  # w, x, y, z: body z along n
+    m.add_body(name="block", mass=2.0, inertia=[0.1, 0.2, 0.3], orientation=tilt,
+               linear_velocity=[1.0, 0, 0], angular_velocity=[0, 0, omega])
+    kinds = ("inplane", "parallel_axes") if composed else ("planar",)
+    for kind in kinds:
+        m.add(kind, name=kind, body_a="ground", on_a=odyn.frame([0, 0, 0], n), body_b="block")
+    m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+    r = odyn.simulate(m, t_end=1.0, rtol=1e-10, atol=1e-10, output_interval=0.25)
+    g_plane = np.array([0, 0, -G]) + G * math.cos(alpha) * np.array(n)
+    expected = np.outer(r.t, [1.0, 0, 0]) + 0.5 * np.outer(r.t**2, g_plane)
+    np.testing.assert_allclose(r.body("block").position, expected, atol=1e-8)
+    np.testing.assert_allclose(r.body("block").angular_velocity[:, 2], omega, atol=1e-8)
+
+
+def test_spherical_and_perpendicular_make_a_universal_joint():
+    # A body hung from a Cardan joint swings the same way as from a ball joint plus the
+    # perpendicular primitive on the cross's two axes.
+    covers("perpendicular")
+
+    def hung(composed):
+        m = odyn.Model()
+        m.add_body(name="arm", mass=1.0, inertia=[0.05, 0.02, 0.04], position=[0.3, 0, -0.4],
+                   angular_velocity=[0.5, 1.0, -0.3])
+        on_a, on_b = odyn.frame([0, 0, 0], X), odyn.frame([-0.3, 0, 0.4], Y)
+        if composed:
+            m.add_spherical(name="ball", body_a="ground", body_b="arm", point_b=[-0.3, 0, 0.4])
+            m.add_perpendicular(name="cross", body_a="ground", on_a=on_a, body_b="arm",
+                                on_b=on_b)
+        else:
+            m.add_universal(name="cross", body_a="ground", on_a=on_a, body_b="arm", on_b=on_b)
+        m.add_gravity(name="gravity", acceleration=[0, 0, -G])
+        return odyn.simulate(m, t_end=1.0, rtol=1e-10, atol=1e-10, output_interval=0.1)
+
+    reference, composed = hung(False), hung(True)
+    np.testing.assert_allclose(composed.q, reference.q, atol=1e-7)
 
 
 def test_engine_gas_force_is_covered_by_the_engine_tests():

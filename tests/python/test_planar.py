@@ -189,6 +189,25 @@ def test_rsda_and_a_python_torque_on_two_bodies_agree():
     np.testing.assert_allclose(r.body("rotor").angle, expected, atol=2e-5)
 
 
+def test_pin_in_an_inclined_slot_slides_and_spins():
+    # in-line (a pin in a slot): the block's centre on a slot inclined by alpha slides with
+    # g sin(alpha) along it and keeps its spin; the slot pushes with m g cos(alpha) across it.
+    covers("inline")
+    alpha, omega, mass = 0.4, 3.0, 2.0
+    m = odyn.PlanarModel()
+    m.add_body("block", mass=mass, inertia=0.1, angular_velocity=omega)
+    m.add_inline("slot", "ground", on_a=odyn.frame([0, 0], [math.cos(alpha), -math.sin(alpha)]),
+                 body_b="block")
+    m.add_gravity("gravity", (0, -G))
+    r = odyn.simulate(m, t_end=1.0, rtol=1e-10, atol=1e-10, output_interval=0.25)
+    s = 0.5 * G * math.sin(alpha) * r.t**2
+    expected = np.column_stack([s * math.cos(alpha), -s * math.sin(alpha)])
+    np.testing.assert_allclose(r.body("block").position, expected, atol=1e-9)
+    np.testing.assert_allclose(r.body("block").angle, omega * r.t, atol=1e-9)
+    normal = mass * G * math.cos(alpha) * np.array([math.sin(alpha), math.cos(alpha)])
+    np.testing.assert_allclose(r.reaction("slot").force[-1], normal, atol=1e-8)
+
+
 def test_engine_gas_force_is_covered_by_the_slider_crank_tests():
     covers("engine_gas_force")  # test_examples.py: the planar slider-crank against the engine
 

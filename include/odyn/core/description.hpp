@@ -41,7 +41,7 @@ struct ParameterKind {
 };
 
 /// Every kind a description may use. A vector's default 0 is the space's zero vector.
-inline constexpr std::array<ParameterKind, 15> parameter_kinds{{
+inline constexpr std::array<ParameterKind, 16> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
@@ -52,6 +52,7 @@ inline constexpr std::array<ParameterKind, 15> parameter_kinds{{
      "the origin, the z axis, a reference chosen from the other body's), {point, axis} in the "
      "plane (an axis left out is the other body's at the initial pose)"},
     {"number", "a finite number"},
+    {"flag", "true or false"},
     {"nonnegative", "a finite number >= 0"},
     {"positive", "a finite number > 0"},
     {"axes", "\"global\" or \"body\": the axes a vector is given in"},

@@ -29,6 +29,12 @@ inline constexpr std::array<Parameter, 5> point_pair{{
     {"point_b", "vector", "0", "m", "the point on body b, in b's coordinates"},
 }};
 
+/// A distance constraint: two points and the distance they keep.
+inline constexpr std::array<Parameter, 6> distance =
+    join(point_pair,
+         std::array<Parameter, 1>{{{"length", "number", "0", "m",
+                                    "the distance kept; <= 0: the distance at the initial pose"}}});
+
 /// A driver: an existing joint, or two bodies and their frames; and the motion.
 inline constexpr std::array<Parameter, 7> driver{{
     {"name", "name", nullptr, "", "the element's name"},

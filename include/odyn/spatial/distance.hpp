@@ -11,13 +11,10 @@ namespace odyn::spatial {
 class Distance : public PairJoint {
  public:
   static constexpr int num_equations = 1;
-  static constexpr std::array<Parameter, 6> parameter_list =
-      join(parameters::point_pair,
-           std::array<Parameter, 1>{{"length", "number", "0", "m",
-                                     "the distance kept; <= 0: the distance at the initial pose"}});
   static constexpr ElementDescription description{
       "distance", "joint",
-      "Distance (massless rod): the two points keep their distance. 1 equation.", parameter_list};
+      "Distance (massless rod): the two points keep their distance. 1 equation.",
+      parameters::distance};
   template <class Reader>
   static Distance from_parameters(Reader& r) {
     return parameters::from_point_pair<Distance, Eigen::Vector3d>(r,
