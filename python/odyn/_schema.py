@@ -239,7 +239,7 @@ SPACE_KINDS = {"spatial": _kinds(3, check_frame), "planar": _kinds(2, check_plan
 
 #: What each kind means, from the compiled core (for the documentation).
 KIND_DOCS: Dict[str, str] = dict(_core.parameter_kinds)
-assert set(KIND_DOCS) == set(SPACE_KINDS["spatial"]), "a parameter kind without its check, or the reverse"
+assert set(KIND_DOCS) == set(SPACE_KINDS["spatial"]), "a kind without its check, or the reverse"
 
 
 def _default(kind: str, text: Optional[str], dim: int) -> Any:

@@ -1,5 +1,5 @@
-"""Command line: odyn run SCENE [options], odyn check SCENE, odyn integrators (also
-python -m odyn)."""
+"""Command line: odyn run SCENE [options], odyn check SCENE, odyn integrators, odyn elements
+[TYPE] (also python -m odyn)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import List, NoReturn, Optional, Tuple
 
 import numpy as np
 
-from . import _core
+from . import _core, _schema
 from .results import (ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Interrupted, Result,
                       chosen_integrator, integrators)
 from .scene import Scene, load, write_table
@@ -56,6 +56,9 @@ def _parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="check a scene file and describe its model")
     check.add_argument("scene")
     sub.add_parser("integrators", help="list the integrators, by name")
+    elements = sub.add_parser("elements", help="list the element types, or one type's parameters")
+    elements.add_argument("type", nargs="?", help="an element type: its parameters")
+    elements.add_argument("--planar", action="store_true", help="the planar catalogue")
     return p
 
 
@@ -231,6 +234,27 @@ def _integrators() -> int:
     return 0
 
 
+def _elements(element_type: Optional[str], planar: bool) -> int:
+    """The catalogue of a space as its elements describe themselves (docs/elements.md has it
+    all)."""
+    space = "planar" if planar else "spatial"
+    catalogue = _schema.DESCRIPTIONS[space]
+    if element_type is None:
+        for name, d in catalogue.items():
+            print(f"{name:22} {d['category']:7} {d['summary']}")
+        return 0
+    if element_type not in catalogue:
+        raise ValueError(f"no {space} element type '{element_type}'; the {space} types are: "
+                         + ", ".join(catalogue))
+    d = catalogue[element_type]
+    print(f"{element_type} ({space} {d['category']}): {d['summary']}")
+    for p in d["parameters"]:
+        default = "required" if p["default"] is None else f"default {p['default']}"
+        unit = f", {p['unit']}" if p["unit"] else ""
+        print(f"  {p['name']:22} {p['kind']}{unit}; {default}. {p['doc']}")
+    return 0
+
+
 def _format_warning(message, category, filename, lineno, line=None) -> str:
     """A warning as one line, "odyn: warning: ...": the source line of the library that issued
     it means nothing to the user of a scene."""
@@ -243,6 +267,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     try:
         if args.command == "integrators":
             return _integrators()
+        if args.command == "elements":
+            return _elements(args.type, args.planar)
         return _run(args) if args.command == "run" else _check(args)
     except (_core.Error, ValueError, OSError) as e:
         print(f"odyn: {e}", file=sys.stderr)

@@ -111,3 +111,16 @@ def test_drivers_need_a_joint_or_both_bodies():
     m.add_revolute_driver("motor", odyn.constant_velocity(1.0), joint="pin")
     assert m.element("motor")["body_b"] == "crank"
     assert "joint" not in m.element("motor")
+
+
+def test_the_command_line_lists_the_catalogue(capsys):
+    from odyn import cli
+    assert cli.main(["elements"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == list(_schema.DESCRIPTIONS["spatial"])
+    assert cli.main(["elements", "inline", "--planar"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("inline (planar joint): In-line primitive")
+    assert "on_a" in out and "frame, m; default null" in out
+    assert cli.main(["elements", "gear"]) == 1
+    assert "no spatial element type 'gear'" in capsys.readouterr().err
