@@ -7,6 +7,7 @@ floats, dicts) or raise `SceneError` naming the place (``joints[2].axis``) and w
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import json
 import math
@@ -97,8 +98,10 @@ def check_keys(d: Any, where: str, allowed: Sequence[str], required: Sequence[st
         fail(where, f"expected an object (a dict), got {_describe(d)}")
     for key in d:
         if key not in allowed:
+            close = difflib.get_close_matches(str(key), [str(a) for a in allowed], n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
             fail(f"{where}.{key}" if where else str(key),
-                 f"unknown key; expected one of {', '.join(allowed)}")
+                 f"unknown key; expected one of {', '.join(allowed)}{hint}")
     for key in required:
         if key not in d:
             fail(where, f"missing '{key}'")

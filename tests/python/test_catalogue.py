@@ -69,6 +69,8 @@ def test_unknown_keys_are_refused_with_the_valid_ones():
     with pytest.raises(odyn.SceneError, match=r"gravity 'g'\.accelaration: unknown key; "
                        r"expected one of name, acceleration"):
         m.add("gravity", name="g", accelaration=[0, 0, -9.81])
+    with pytest.raises(odyn.SceneError, match=r"\(did you mean 'acceleration'\?\)"):
+        m.add("gravity", name="g", accelaration=[0, 0, -9.81])
     with pytest.raises(TypeError, match="accelaration"):
         m.add_gravity("g", accelaration=[0, 0, -9.81])
     with pytest.raises(odyn.SceneError, match=r"forces\[0\]\.stifness: unknown key; expected "
@@ -124,3 +126,20 @@ def test_the_command_line_lists_the_catalogue(capsys):
     assert "on_a" in out and "frame, m; default null" in out
     assert cli.main(["elements", "gear"]) == 1
     assert "no spatial element type 'gear'" in capsys.readouterr().err
+
+
+def test_a_new_element_reaches_scene_files_with_no_code_of_its_own():
+    # The joint primitives were added by their C++ descriptions alone: a scene names them as it
+    # names any joint, and a scene's planar pin-in-slot runs.
+    scene = odyn.loads("""{
+        "space": "planar",
+        "bodies": [{"name": "block", "mass": 2, "inertia": 0.1}],
+        "joints": [{"type": "inline", "name": "slot", "body_a": "ground", "body_b": "block",
+                    "on_a": {"axis": [1, 0]}}],
+        "forces": [{"type": "gravity", "name": "g", "acceleration": [0, -9.81]}],
+        "analysis": {"t_end": 0.5, "output_interval": 0.5}
+    }""")
+    result = scene.simulate()
+    # The slot is horizontal: the block stays on it, at rest.
+    assert result.body("block").position[-1] == pytest.approx([0, 0], abs=1e-12)
+    assert result.reaction("slot").force[-1] == pytest.approx([0, 2 * 9.81], abs=1e-9)
