@@ -184,7 +184,7 @@ def elements_markdown() -> str:
         out += ["", f"## {space.capitalize()} elements", "",
                 "| type | category | what it does |", "|---|---|---|"]
         for t, element in _schema.DESCRIPTIONS[space].items():
-            out.append(f"| [`{t}`](#{space}-{t.replace('_', '-')}) | {element['category']} | "
+            out.append(f"| [`{t}`](#{space}-{t}) | {element['category']} | "
                        f"{_cell(element['summary'])} |")
         for t, element in _schema.DESCRIPTIONS[space].items():
             out += ["", f"### {space}: {t}", "", element["summary"], "",
