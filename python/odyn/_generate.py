@@ -174,6 +174,24 @@ def elements_markdown() -> str:
         "A parameter without a default is required; an unknown one is refused with the list of "
         "valid ones.",
         "",
+        "## Adding an element",
+        "",
+        "1. Write its header: the blocks (see the README's *Writing an element*), then",
+        "   `static constexpr ElementDescription description{type, category, summary, "
+        "parameters}` and `template <class Reader> static E from_parameters(Reader& r)`, "
+        "which builds it with `parameter<T>(r, \"key\")` for each described key (the lists "
+        "in `include/odyn/core/parameter_blocks.hpp` cover two bodies with frames or points, "
+        "drivers and spring laws; `include/odyn/spatial/joint_primitives.hpp` is a short "
+        "example).",
+        "2. Register it: add the type to `odyn::spatial::DefaultModel` or "
+        "`odyn::planar::DefaultModel` and to the matching model type of the Python bindings "
+        "(`python/src/bindings.hpp`; a static_assert there fails until it holds every type of "
+        "both catalogues). Nothing else names it.",
+        "3. Run `python -m odyn._generate` from the repository (after `bash scripts/setup.sh`): "
+        "it writes the Python method and this page. Then a test against an independent "
+        "reference (`tests/test_descriptions.cpp` already checks that the description and "
+        "`from_parameters` agree).",
+        "",
         "## Parameter kinds",
         "",
         "| kind | value |",
