@@ -111,7 +111,7 @@ class DictReader {
       const std::string key = py::str(item.first).cast<std::string>();
       bool used = false;
       for (const std::string& read : read_) used = used || read == key;
-      if (used || (key == "joint" && declares("joint"))) continue;  // drivers: resolved earlier
+      if (used) continue;
       std::string valid;
       for (const Parameter& p : description_.parameters)
         valid += std::string(valid.empty() ? "" : ", ") + p.name;
