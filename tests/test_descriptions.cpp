@@ -53,6 +53,8 @@ class InventedValues {
       return k == "point_b" ? Eigen::Vector2d(-0.3, 0.4) : Eigen::Vector2d(0.1, 0.2);
     } else if constexpr (std::is_same_v<T, Eigen::Matrix<double, 1, 1>>) {
       return Eigen::Matrix<double, 1, 1>(0.5);
+    } else if constexpr (requires { T::Identity(); }) {
+      return T::Identity();  // a bushing's stiffness and damping, a 6-vector preload
     } else {
       return T{};  // functions: none (the elements take constants or no actuator then)
     }

@@ -7,6 +7,7 @@
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
 #include "odyn/planar/body.hpp"
+#include "odyn/planar/bushing.hpp"
 #include "odyn/planar/distance.hpp"
 #include "odyn/planar/drivers.hpp"
 #include "odyn/planar/fixed.hpp"
@@ -27,7 +28,8 @@ template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every planar element type of the library (what scripting uses).
-using DefaultModel = Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver,
-                           TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
+using DefaultModel =
+    Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver, TranslationalDriver,
+          Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing>;
 
 }  // namespace odyn::planar

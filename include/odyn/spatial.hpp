@@ -6,6 +6,7 @@
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
 #include "odyn/spatial/body.hpp"
+#include "odyn/spatial/bushing.hpp"
 #include "odyn/spatial/cylindrical.hpp"
 #include "odyn/spatial/distance.hpp"
 #include "odyn/spatial/drivers.hpp"
@@ -32,6 +33,6 @@ using Model = odyn::Model<Body, Elements...>;
 using DefaultModel =
     Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
           InLine, InPlane, Orientation, ParallelAxes, Perpendicular, RevoluteDriver,
-          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda>;
+          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing>;
 
 }  // namespace odyn::spatial

@@ -8,7 +8,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Sequence, Union
 
 if TYPE_CHECKING:
-    from .model import Frame, FrameFunction, PlanarFunction, Vector
+    from .model import (ComponentMatrix, Frame, FrameFunction, PlanarFunction, Vector,
+                        WrenchLaw)
 
 
 class _Adds:
@@ -324,6 +325,31 @@ class SpatialElements(_Adds):
             "rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
             stiffness=stiffness, damping=damping, free_angle=free_angle, actuator=actuator)
 
+    def add_bushing(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None, stiffness: ComponentMatrix = 0,
+            damping: ComponentMatrix = 0, preload: Sequence[float] = (0, 0, 0, 0, 0, 0),
+            law: Optional[WrenchLaw] = None) -> str:
+        """Six-component spring-damper between frame a and frame b: force and torque on b -K x - C
+        x' + preload + law(t, x, x'), x = (b's origin in a's axes, rotation vector).
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the bushing's frame on body a (axes left out: the body's; a reference left out:
+        its x axis, or y).
+        body_b: the second body.
+        on_b (m): the bushing's frame on body b (the same defaults).
+        stiffness (N/m, N m/rad): K: one number per component (a diagonal) or the full symmetric
+        matrix.
+        damping (N s/m, N m s/rad): C: one number per component (a diagonal) or the full symmetric
+        matrix.
+        preload (N, N m): the force and torque on b at zero displacement.
+        law (N, N m): law(t, x, x') -> an extra generalized force (a nonlinear bushing).
+        """
+        return self._add_given(
+            "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
+            stiffness=stiffness, damping=damping, preload=preload, law=law)
+
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
             D: float = 0.08, C: float = 9.0, p_atm: float = 101325.0, kappa: float = 1.4,
@@ -555,6 +581,31 @@ class PlanarElements(_Adds):
         return self._add_given(
             "rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
             stiffness=stiffness, damping=damping, free_angle=free_angle, actuator=actuator)
+
+    def add_bushing(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None, stiffness: ComponentMatrix = 0,
+            damping: ComponentMatrix = 0, preload: Sequence[float] = (0, 0, 0),
+            law: Optional[WrenchLaw] = None) -> str:
+        """Three-component spring-damper between frame a and frame b: force and torque on b -K x -
+        C x' + preload + law(t, x, x'), x = (b's origin in a's axes, joint angle).
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the bushing's frame on body a (axes left out: the body's; a reference left out:
+        its x axis, or y).
+        body_b: the second body.
+        on_b (m): the bushing's frame on body b (the same defaults).
+        stiffness (N/m, N m/rad): K: one number per component (a diagonal) or the full symmetric
+        matrix.
+        damping (N s/m, N m s/rad): C: one number per component (a diagonal) or the full symmetric
+        matrix.
+        preload (N, N m): the force and torque on b at zero displacement.
+        law (N, N m): law(t, x, x') -> an extra generalized force (a nonlinear bushing).
+        """
+        return self._add_given(
+            "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
+            stiffness=stiffness, damping=damping, preload=preload, law=law)
 
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,

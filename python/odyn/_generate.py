@@ -42,6 +42,9 @@ _ANNOTATIONS: Dict[str, Tuple[str, str]] = {
     "optional_callable": ("Callable[[float, float, float], float]",
                           "Callable[[float, float, float], float]"),
     "callable": ("Callable[..., Any]", "Callable[..., Any]"),
+    "wrench": ("Sequence[float]", "Sequence[float]"),
+    "component_matrix": ("ComponentMatrix", "ComponentMatrix"),
+    "wrench_law": ("WrenchLaw", "WrenchLaw"),
 }
 
 
@@ -51,6 +54,10 @@ def _python_default(kind: str, text: str, dim: int) -> str:
         return "None"
     if kind == "vector" and value == 0:
         return "(" + ", ".join(["0"] * dim) + ")"
+    if kind == "wrench" and value == 0:
+        return "(" + ", ".join(["0"] * (6 if dim == 3 else 3)) + ")"
+    if kind == "component_matrix" and value == 0:
+        return "0"  # the zero matrix
     if kind in ("number", "nonnegative", "positive"):
         return repr(float(value))
     return repr(value)
@@ -138,7 +145,8 @@ def elements_source() -> str:
         "from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Sequence, Union",
         "",
         "if TYPE_CHECKING:",
-        "    from .model import Frame, FrameFunction, PlanarFunction, Vector",
+        "    from .model import (ComponentMatrix, Frame, FrameFunction, PlanarFunction, Vector,",
+        "                        WrenchLaw)",
         "",
         "",
         "class _Adds:",

@@ -204,10 +204,27 @@ def _bodies(x, where, bodies):
     return [_body(b, f"{where}[{i}]", bodies) for i, b in enumerate(x)]
 
 
+def check_component_matrix(x: Any, where: str, size: int) -> List[List[float]]:
+    """A matrix over a wrench's `size` components: the full matrix, a list of its diagonal, or
+    0 (symmetry and definiteness are the element's to check)."""
+    if hasattr(x, "tolist"):  # numpy arrays
+        x = x.tolist()
+    if _is_number(x) and x == 0:
+        return [[0.0] * size for _ in range(size)]
+    if isinstance(x, (list, tuple)) and len(x) == size and all(_is_number(v) for v in x):
+        diagonal = check_vector(x, where, size)
+        return [[diagonal[i] if i == j else 0.0 for j in range(size)] for i in range(size)]
+    if not isinstance(x, (list, tuple)) or len(x) != size:
+        fail(where, f"expected {size} numbers (a diagonal) or a {size} x {size} matrix, got "
+             f"{_describe(x)}")
+    return [check_vector(row, f"{where}[{i}]", size) for i, row in enumerate(x)]
+
+
 def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[Any, str, Any],
                                                                           Any]]:
     """How each parameter kind (odyn/core/description.hpp) checks a value in a space whose
     vectors have `dim` components."""
+    wrench = 6 if dim == 3 else 3  # a force and a torque
 
     def vector_or_callable(x, where, bodies):
         return x if callable(x) else check_vector(x, where, dim)
@@ -234,6 +251,9 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
         "angular_or_callable": angular_or_callable,
         "optional_callable": lambda x, w, b: None if x is None else check_callable(x, w),
         "callable": lambda x, w, b: check_callable(x, w),
+        "wrench": lambda x, w, b: check_vector(x, w, wrench),
+        "component_matrix": lambda x, w, b: check_component_matrix(x, w, wrench),
+        "wrench_law": lambda x, w, b: None if x is None else check_callable(x, w),
     }
 
 
@@ -246,12 +266,18 @@ assert set(KIND_DOCS) == set(SPACE_KINDS["spatial"]), "a kind without its check,
 
 
 def _default(kind: str, text: Optional[str], dim: int) -> Any:
-    """A parameter's default from its JSON text; a vector's 0 is the zero vector."""
+    """A parameter's default from its JSON text; a vector's, a wrench's or a matrix's 0 is
+    zero."""
     if text is None:
         return REQUIRED
     value = json.loads(text)
+    wrench = 6 if dim == 3 else 3
     if kind == "vector" and value == 0:
         return [0.0] * dim
+    if kind == "wrench" and value == 0:
+        return [0.0] * wrench
+    if kind == "component_matrix" and value == 0:
+        return [[0.0] * wrench for _ in range(wrench)]
     return value
 
 

@@ -24,6 +24,11 @@ PlanarFunction = Callable[[float, Any], Any]
 #: A force or torque function: f(t, body) -> 3 numbers, body.position, body.rotation (3 x 3,
 #: body to global), body.linear_velocity (global), body.angular_velocity (body axes).
 FrameFunction = Callable[[float, Any], Sequence[float]]
+#: A matrix over a wrench's components (a bushing's stiffness): 6 x 6 (3 x 3 in the plane), or a
+#: list of its diagonal.
+ComponentMatrix = Union[Sequence[float], Sequence[Sequence[float]]]
+#: A bushing's law: f(t, x, x') -> a wrench, x and x' NumPy arrays of 6 numbers (3 in the plane).
+WrenchLaw = Callable[[float, Any, Any], Sequence[float]]
 
 
 def frame(point: Optional[Vector] = None, axis: Optional[Vector] = None,

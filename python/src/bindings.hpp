@@ -82,6 +82,8 @@ class Callable {
   py::object call_with_frames(double t, const typename Space::Frame* const* frames);
   /// function(a, b, c) for scalar arguments; the GIL must be held.
   py::object call_with_numbers(std::initializer_list<double> numbers);
+  /// function(t, x, y) for two vectors of n numbers, passed as NumPy arrays; the GIL must be held.
+  py::object call_with_vectors(double t, const double* x, const double* y, int n);
   const std::string& what() const { return what_; }
 
  private:
@@ -218,15 +220,15 @@ using Model =
     sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
               sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane, sp::Orientation,
               sp::ParallelAxes, sp::Perpendicular, sp::RevoluteDriver, sp::TranslationalDriver,
-              sp::Gravity, sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, EngineGasForce,
-              UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+              sp::Gravity, sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing,
+              EngineGasForce, UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
 using PlanarModel =
     pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
               pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity, pl::PointForce,
-              pl::PointTorque, pl::Tsda, pl::Rsda, PlanarEngineGasForce, UserForceT<Planar, 1>,
-              UserForceT<Planar, 2>, SignalWatch<Planar>>;
+              pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, PlanarEngineGasForce,
+              UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
 /// DefaultModel): a new element in the library fails this check until the bindings have it.

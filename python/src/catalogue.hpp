@@ -24,6 +24,21 @@ struct IsFixedVector : std::false_type {};
 template <int N>
 struct IsFixedVector<Eigen::Matrix<double, N, 1>> : std::true_type {};
 
+template <class T>
+struct IsFixedSquare : std::false_type {};
+template <int N>
+struct IsFixedSquare<Eigen::Matrix<double, N, N>> : std::bool_constant<(N > 1)> {};
+
+/// std::function<V(double, const V&, const V&)>: a law of a displacement and its rate.
+template <class T>
+struct VectorLaw : std::false_type {};
+template <int N>
+struct VectorLaw<std::function<Eigen::Matrix<double, N, 1>(
+    double, const Eigen::Matrix<double, N, 1>&, const Eigen::Matrix<double, N, 1>&)>>
+    : std::true_type {
+  using Vector = Eigen::Matrix<double, N, 1>;
+};
+
 /// std::function<Vector(double, const Frame&)>: a function of time and one body's frame.
 template <class T>
 struct FrameFunction : std::false_type {};
@@ -84,6 +99,11 @@ class DictReader {
       if (present(d, "point")) frame.point = d["point"].cast<Eigen::Vector2d>();
       if (present(d, "axis")) frame.axis = d["axis"].cast<Eigen::Vector2d>();
       return frame;
+    } else if constexpr (detail::IsFixedSquare<T>::value) {
+      return value.cast<T>();  // the Python layer made a diagonal a full matrix
+    } else if constexpr (detail::VectorLaw<T>::value) {
+      if (value.is_none()) return {};
+      return vector_law<typename detail::VectorLaw<T>::Vector>(value, key);
     } else if constexpr (detail::IsFixedVector<T>::value) {
       if constexpr (T::RowsAtCompileTime == 1) {
         if (PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()))
@@ -135,6 +155,19 @@ class DictReader {
     read_.emplace_back(key);
     if (!values_.contains(key)) return py::none();
     return values_[key];
+  }
+
+  /// law(t, x, x') -> V from a Python callable taking (t, x, x') with NumPy arrays.
+  template <class V>
+  std::function<V(double, const V&, const V&)> vector_law(py::object f, const char* key) const {
+    auto callable = std::make_shared<Callable<Spatial>>(std::move(f), 0, what_ + " " + key);
+    return [callable](double t, const V& x, const V& rate) {
+      V value;
+      py::gil_scoped_acquire gil;
+      read_numbers(callable->call_with_vectors(t, x.data(), rate.data(), int(V::RowsAtCompileTime)),
+                   value.data(), int(V::RowsAtCompileTime), callable->what());
+      return value;
+    };
   }
 
   template <class F>

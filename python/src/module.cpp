@@ -157,6 +157,16 @@ py::object Callable<Space>::call_with_numbers(std::initializer_list<double> numb
   return py::reinterpret_steal<py::object>(result);
 }
 
+template <class Space>
+py::object Callable<Space>::call_with_vectors(double t, const double* x, const double* y, int n) {
+  const auto array = [n](const double* values) {
+    py::array_t<double> out(n);
+    std::copy(values, values + n, out.mutable_data());
+    return out;
+  };
+  return function_(t, array(x), array(y));
+}
+
 template class Callable<Spatial>;
 template class Callable<Planar>;
 

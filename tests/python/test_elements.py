@@ -380,6 +380,106 @@ def test_spherical_and_perpendicular_make_a_universal_joint():
     np.testing.assert_allclose(composed.q, reference.q, atol=1e-7)
 
 
+def rotation_vectors(quaternions):
+    """Rotation vectors (axis times angle) of unit quaternions w, x, y, z."""
+    w = np.abs(quaternions[:, 0])
+    v = quaternions[:, 1:] * np.sign(quaternions[:, :1])
+    s = np.linalg.norm(v, axis=1)
+    scale = np.where(s > 1e-12, 2 * np.arctan2(s, w) / np.maximum(s, 1e-300), 2.0)
+    return v * scale[:, None]
+
+
+def test_bushing_mount_vibrates_in_its_analytic_modes():
+    # A block on a bushing at its centre of mass: the six components are uncoupled, each at
+    # sqrt(k / m) or sqrt(k / J). Started displaced by 1e-5 in every one, each follows
+    # x0 cos(w t) (the coupling through large angles is of order 1e-10 here).
+    covers("bushing")
+    k = [4e4, 2e4, 3e4, 300, 200, 100]
+    inertia = [0.04, 0.07, 0.09]
+    x0 = np.array([1, -2, 3, 2, -1, 1.5]) * 1e-5
+    m = odyn.Model()
+    m.add_body(name="block", mass=3.0, inertia=inertia, position=x0[:3],
+               orientation=list(np.r_[np.cos(np.linalg.norm(x0[3:]) / 2),
+                                      np.sin(np.linalg.norm(x0[3:]) / 2) * x0[3:]
+                                      / np.linalg.norm(x0[3:])]))
+    m.add_bushing("mount", "ground", body_b="block", stiffness=k)
+    r = odyn.simulate(m, t_end=0.3, output_interval=0.005, integrator="dop853", rtol=1e-12,
+                      atol=1e-13)
+    omega = np.sqrt(np.array(k) / np.r_[[3.0] * 3, inertia])
+    expected = x0 * np.cos(np.outer(r.t, omega))
+    block = r.body("block")
+    motion = np.c_[block.position, rotation_vectors(block.orientation)]
+    np.testing.assert_allclose(motion, expected, atol=1e-4 * np.abs(x0).max())
+
+
+def test_bushing_full_matrix_and_a_law_written_in_python():
+    # The full 6 x 6 stiffness of a bushing offset from the centre of mass: its modes are those
+    # of (A^T K A) phi = w^2 M phi, A the map from the block's small motion to the bushing's
+    # displacement, with the bushing 0.2 m along x from the centre (frames coincide at rest).
+    rng = np.random.default_rng(3)
+    b = rng.uniform(-1, 1, (6, 6))
+    root = np.sqrt([4e4, 2e4, 3e4, 400, 200, 300])
+    stiffness = root[:, None] * (0.5 * np.eye(6) + b @ b.T / 6) * root[None, :]
+    s = np.array([0.2, 0.0, 0.0])
+    skew = np.array([[0, -s[2], s[1]], [s[2], 0, -s[0]], [-s[1], s[0], 0]])
+    a = np.block([[np.eye(3), -skew], [np.zeros((3, 3)), np.eye(3)]])
+    mass = np.diag([3.0, 3.0, 3.0, 0.04, 0.07, 0.09])
+    root_m = np.diag(1 / np.sqrt(np.diag(mass)))
+    w2, shapes = np.linalg.eigh(root_m @ a.T @ stiffness @ a @ root_m)
+    mode = 2
+    shape = root_m @ shapes[:, mode]
+    shape *= 1e-6 / np.abs(shape).max()
+    angle = np.linalg.norm(shape[3:])
+    m = odyn.Model()
+    m.add_body(name="block", mass=3.0, inertia=[0.04, 0.07, 0.09], position=shape[:3],
+               orientation=[np.cos(angle / 2), *(np.sin(angle / 2) * shape[3:] / angle)])
+    m.add_bushing("mount", "ground", on_a=odyn.frame(s, Z), body_b="block",
+                  on_b=odyn.frame(s, Z), stiffness=stiffness)
+    omega = np.sqrt(w2[mode])
+    r = odyn.simulate(m, t_end=3 * np.pi / omega, output_interval=0.1 / omega,
+                      integrator="dop853", rtol=1e-12, atol=1e-14)
+    block = r.body("block")
+    motion = np.c_[block.position, rotation_vectors(block.orientation)]
+    np.testing.assert_allclose(motion, np.outer(np.cos(omega * r.t), shape), atol=1e-10)
+
+    # A law written in Python: a spring and damper along z, k z + c z', under the default
+    # (implicit) integrator, against the closed-form damped oscillator.
+    k, c, mass_z, z0 = 5e3, 8.0, 2.0, 0.004
+    seen = []
+
+    def law(t, x, rate):
+        seen.append((x.shape, rate.shape))
+        return [0, 0, -k * x[2] - c * rate[2], 0, 0, 0]
+
+    m = odyn.Model()
+    m.add_body(name="block", mass=mass_z, inertia=[0.01] * 3, position=[0, 0, z0])
+    m.add_bushing("mount", "ground", body_b="block", stiffness=[1e5, 1e5, 0, 1e3, 1e3, 1e3],
+                  law=law)
+    r = odyn.simulate(m, t_end=0.5, output_interval=0.01, rtol=1e-9, atol=1e-11)
+    assert seen[0] == ((6,), (6,))
+    omega, zeta = np.sqrt(k / mass_z), c / (2 * np.sqrt(k * mass_z))
+    omega_d = omega * np.sqrt(1 - zeta**2)
+    z = z0 * np.exp(-zeta * omega * r.t) * (np.cos(omega_d * r.t)
+                                            + zeta / np.sqrt(1 - zeta**2) * np.sin(omega_d * r.t))
+    np.testing.assert_allclose(r.body("block").position[:, 2], z, atol=2e-7)
+
+
+def test_bushing_refuses_bad_matrices_by_name():
+    m = odyn.Model()
+    m.add_body(name="block", mass=1.0, inertia=[0.1] * 3)
+    bad = np.diag([1.0] * 6)
+    bad[0, 1] = 0.5
+    with pytest.raises(odyn.ModelError, match="bushing 'mount'.*stiffness matrix is not "
+                       "symmetric"):
+        m.add_bushing("mount", "ground", body_b="block", stiffness=bad)
+    with pytest.raises(odyn.ModelError, match="damping matrix is not positive semidefinite"):
+        m.add_bushing("mount", "ground", body_b="block", damping=[1, 1, -1, 1, 1, 1])
+    with pytest.raises(odyn.ModelError, match="expected 6 numbers .a diagonal. or a 6 x 6"):
+        m.add_bushing("mount", "ground", body_b="block", stiffness=[1, 2, 3])
+    with pytest.raises(odyn.ModelError, match="preload.*6 numbers"):
+        m.add_bushing("mount", "ground", body_b="block", preload=[1, 2, 3])
+
+
 def test_engine_gas_force_is_covered_by_the_engine_tests():
     covers("engine_gas_force")  # tests/python/test_engine.py checks it against the C++ example
 

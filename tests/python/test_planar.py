@@ -212,6 +212,48 @@ def test_engine_gas_force_is_covered_by_the_slider_crank_tests():
     covers("engine_gas_force")  # test_examples.py: the planar slider-crank against the engine
 
 
+def test_bushing_mount_modes_and_a_scene():
+    # A block on a planar bushing 0.2 m from its centre, with a coupled 3 x 3 stiffness: small
+    # vibrations follow the modes of (A^T K A) phi = w^2 M phi, A the map from the block's
+    # motion (x, y, phi) to the bushing's displacement (here A = [[1, 0, -0.2 sin 0], [0, 1,
+    # 0.2], [0, 0, 1]] with the bushing on the block's x axis).
+    covers("bushing")
+    rng = np.random.default_rng(4)
+    b = rng.uniform(-1, 1, (3, 3))
+    root = np.sqrt([2e4, 1e4, 200.0])
+    stiffness = root[:, None] * (0.5 * np.eye(3) + b @ b.T / 3) * root[None, :]
+    a = np.array([[1.0, 0, 0], [0, 1, 0.2], [0, 0, 1]])
+    mass = np.array([1.5, 1.5, 0.02])
+    w2, shapes = np.linalg.eigh(a.T @ stiffness @ a / np.sqrt(np.outer(mass, mass)))
+    for mode in range(3):
+        shape = shapes[:, mode] / np.sqrt(mass)
+        shape *= 1e-6 / np.abs(shape).max()
+        m = odyn.PlanarModel()
+        m.add_body(name="block", mass=1.5, inertia=0.02, position=shape[:2], angle=shape[2])
+        m.add_bushing("mount", "ground", on_a=odyn.frame([0.2, 0]), body_b="block",
+                      on_b=odyn.frame([0.2, 0]), stiffness=stiffness)
+        omega = np.sqrt(w2[mode])
+        r = odyn.simulate(m, t_end=3 * np.pi / omega, output_interval=0.1 / omega,
+                          integrator="dop853", rtol=1e-12, atol=1e-14)
+        block = r.body("block")
+        motion = np.c_[block.position, block.angle]
+        np.testing.assert_allclose(motion, np.outer(np.cos(omega * r.t), shape), atol=1e-10)
+
+    # From a scene file: a preloaded, damped vertical mount under gravity settles where the
+    # spring, the preload and the weight balance: y = (preload - m g) / k.
+    scene = odyn.loads("""{
+        "space": "planar",
+        "bodies": [{"name": "block", "mass": 2, "inertia": 0.1}],
+        "forces": [{"type": "bushing", "name": "mount", "body_a": "ground", "body_b": "block",
+                    "stiffness": [1e4, 1e4, 100], "damping": [50, 50, 1],
+                    "preload": [0, 5, 0]},
+                   {"type": "gravity", "name": "g", "acceleration": [0, -9.81]}],
+        "analysis": {"t_end": 3, "output_interval": 0.5}
+    }""")
+    result = scene.simulate()
+    assert result.body("block").position[-1] == pytest.approx([0, (5 - 2 * G) / 1e4], abs=1e-9)
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

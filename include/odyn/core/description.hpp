@@ -40,8 +40,8 @@ struct ParameterKind {
   const char* doc;
 };
 
-/// Every kind a description may use. A vector's default 0 is the space's zero vector.
-inline constexpr std::array<ParameterKind, 16> parameter_kinds{{
+/// Every kind a description may use. A vector's, a wrench's or a matrix's default 0 is zero.
+inline constexpr std::array<ParameterKind, 19> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
@@ -63,6 +63,15 @@ inline constexpr std::array<ParameterKind, 16> parameter_kinds{{
      "returning one"},
     {"optional_callable", "a function f(t, x, x') returning a number, or null for none"},
     {"callable", "a Python function"},
+    {"wrench",
+     "a force then a torque, in the element's axes: 6 numbers in space, 3 in the plane (fx, fy, "
+     "torque)"},
+    {"component_matrix",
+     "a symmetric positive semidefinite matrix over a wrench's components: 6 x 6 in space, 3 x 3 "
+     "in the plane, or a list of its diagonal"},
+    {"wrench_law",
+     "a function f(t, x, x') of a displacement and its rate (6 numbers each in space, 3 in the "
+     "plane) returning a wrench, or null for none"},
 }};
 
 /// True if a kind of that name is in parameter_kinds.
