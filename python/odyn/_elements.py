@@ -374,6 +374,7 @@ class SpatialElements(_Adds):
 
     def add_user_force(
             self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            jacobians: Optional[Callable[..., Any]] = None,
             difference_jacobians: bool = True) -> str:
         """A force written in Python on one or two bodies (the body views are refreshed before each
         call: copy them to keep them).
@@ -382,11 +383,15 @@ class SpatialElements(_Adds):
         bodies: the one or two bodies it acts on.
         function (N, N m): function(t, body_0[, body_1]) -> per body the global force at the centre
         of mass, then the global torque.
-        difference_jacobians: give implicit integrators the force's stiffness and damping by
-        central differences (12 calls per body and Newton matrix); false: none.
+        jacobians: jacobians(t, body_0[, body_1]) -> (stiffness, damping): -dQ/dq and -dQ/dv over
+        the bodies' velocity coordinates (6 per body in space: the centre globally, then a turn
+        about the body's axes; Q's torque in body axes), each a square array or None; checked once
+        against differences.
+        difference_jacobians: without jacobians, give implicit integrators the force's stiffness
+        and damping by central differences (12 calls per body and Newton matrix); false: none.
         """
         return self._add_given(
-            "user_force", name=name, bodies=bodies, function=function,
+            "user_force", name=name, bodies=bodies, function=function, jacobians=jacobians,
             difference_jacobians=difference_jacobians)
 
 
@@ -631,6 +636,7 @@ class PlanarElements(_Adds):
 
     def add_user_force(
             self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            jacobians: Optional[Callable[..., Any]] = None,
             difference_jacobians: bool = True) -> str:
         """A force written in Python on one or two bodies (the body views are refreshed before each
         call: copy them to keep them).
@@ -639,9 +645,13 @@ class PlanarElements(_Adds):
         bodies: the one or two bodies it acts on.
         function (N, N m): function(t, body_0[, body_1]) -> per body the global force at the centre
         of mass, then the global torque.
-        difference_jacobians: give implicit integrators the force's stiffness and damping by
-        central differences (12 calls per body and Newton matrix); false: none.
+        jacobians: jacobians(t, body_0[, body_1]) -> (stiffness, damping): -dQ/dq and -dQ/dv over
+        the bodies' velocity coordinates (6 per body in space: the centre globally, then a turn
+        about the body's axes; Q's torque in body axes), each a square array or None; checked once
+        against differences.
+        difference_jacobians: without jacobians, give implicit integrators the force's stiffness
+        and damping by central differences (12 calls per body and Newton matrix); false: none.
         """
         return self._add_given(
-            "user_force", name=name, bodies=bodies, function=function,
+            "user_force", name=name, bodies=bodies, function=function, jacobians=jacobians,
             difference_jacobians=difference_jacobians)

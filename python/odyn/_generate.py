@@ -42,6 +42,7 @@ _ANNOTATIONS: Dict[str, Tuple[str, str]] = {
     "optional_callable": ("Callable[[float, float, float], float]",
                           "Callable[[float, float, float], float]"),
     "callable": ("Callable[..., Any]", "Callable[..., Any]"),
+    "optional_function": ("Callable[..., Any]", "Callable[..., Any]"),
     "wrench": ("Sequence[float]", "Sequence[float]"),
     "component_matrix": ("ComponentMatrix", "ComponentMatrix"),
     "wrench_law": ("WrenchLaw", "WrenchLaw"),

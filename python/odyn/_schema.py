@@ -251,6 +251,7 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
         "angular_or_callable": angular_or_callable,
         "optional_callable": lambda x, w, b: None if x is None else check_callable(x, w),
         "callable": lambda x, w, b: check_callable(x, w),
+        "optional_function": lambda x, w, b: None if x is None else check_callable(x, w),
         "wrench": lambda x, w, b: check_vector(x, w, wrench),
         "component_matrix": lambda x, w, b: check_component_matrix(x, w, wrench),
         "wrench_law": lambda x, w, b: None if x is None else check_callable(x, w),

@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -94,23 +95,31 @@ class Callable {
 
 /// A force and torque on N bodies from a Python callable: function(t, body_0, ...,
 /// body_{N-1}) -> per body the global force at its centre of mass, then the global torque
-/// (spatial: 3 + 3 numbers; planar: 2 + 1).
+/// (spatial: 3 + 3 numbers; planar: 2 + 1). Implicit integrators get its stiffness and damping
+/// from the user's `jacobians` function if there is one (checked once against differences, as
+/// its conventions are easy to get wrong), else by central differences, or not at all.
 template <class SpaceT, int N>
 class UserForceT {
  public:
   using Space = SpaceT;
   static constexpr int num_bodies = N;
   static constexpr int width = Space::dim + Space::nw;  // numbers per body
+  static constexpr int size = N * Space::nv;            // rows and columns of a block
 
-  static constexpr std::array<Parameter, 4> parameter_list{{
+  static constexpr std::array<Parameter, 5> parameter_list{{
       {"name", "name", nullptr, "", "the element's name"},
       {"bodies", "bodies", nullptr, "", "the one or two bodies it acts on"},
       {"function", "callable", nullptr, "N, N m",
        "function(t, body_0[, body_1]) -> per body the global force at the centre of mass, "
        "then the global torque"},
+      {"jacobians", "optional_function", "null", "",
+       "jacobians(t, body_0[, body_1]) -> (stiffness, damping): -dQ/dq and -dQ/dv over the "
+       "bodies' velocity coordinates (6 per body in space: the centre globally, then a turn about "
+       "the body's axes; Q's torque in body axes), each a square array or None; checked once "
+       "against differences"},
       {"difference_jacobians", "flag", "true", "",
-       "give implicit integrators the force's stiffness and damping by central differences "
-       "(12 calls per body and Newton matrix); false: none"},
+       "without jacobians, give implicit integrators the force's stiffness and damping by "
+       "central differences (12 calls per body and Newton matrix); false: none"},
   }};
   static constexpr ElementDescription description{
       "user_force", "force",
@@ -119,10 +128,12 @@ class UserForceT {
       parameter_list};
 
   UserForceT(std::string name, const std::array<BodyId, N>& bodies,
-             std::shared_ptr<Callable<Space>> function, bool difference_jacobians = true)
+             std::shared_ptr<Callable<Space>> function, bool difference_jacobians = true,
+             std::shared_ptr<Callable<Space>> jacobians = nullptr)
       : name_(std::move(name)),
         bodies_(bodies),
         function_(std::move(function)),
+        jacobians_(std::move(jacobians)),
         difference_jacobians_(difference_jacobians) {}
 
   const std::string& name() const { return name_; }
@@ -144,10 +155,16 @@ class UserForceT {
     }
   }
 
-  /// Stiffness and damping for implicit integrators' Newton matrices, by central differences
-  /// of the Python function (or none, if the user turned them off).
+  /// Stiffness and damping for implicit integrators' Newton matrices: the user's, by central
+  /// differences of the Python function, or none (if the user turned them off).
   void jacobians(const ElementInput<Space, N>& in, ForceBlocks<Space, N>& out) const {
-    if (difference_jacobians_) {
+    if (jacobians_) {
+      user_jacobians(in, out);
+      if (!checked_->load()) {
+        check_against_differences(in, out);
+        checked_->store(true);  // only once they passed: a model refused stays refused
+      }
+    } else if (difference_jacobians_) {
       difference_jacobians(*this, in, out);
     } else {
       out.stiffness.setZero();
@@ -156,10 +173,61 @@ class UserForceT {
   }
 
  private:
+  using Block = Eigen::Matrix<double, size, size, Eigen::RowMajor>;
+
+  void user_jacobians(const ElementInput<Space, N>& in, ForceBlocks<Space, N>& out) const {
+    py::gil_scoped_acquire gil;
+    const py::object result = jacobians_->call_with_frames(in.t, in.frames.data());
+    const std::string what = jacobians_->what();
+    if (!py::isinstance<py::tuple>(result) && !py::isinstance<py::list>(result))
+      throw py::type_error(what + ": jacobians must return (stiffness, damping), got " +
+                           std::string(py::repr(result)));
+    const py::sequence pair = result.cast<py::sequence>();
+    if (pair.size() != 2)
+      throw py::type_error(what + ": jacobians must return two blocks (stiffness, damping), got " +
+                           std::to_string(pair.size()));
+    const auto read = [&](py::handle value, const char* which, auto& to) {
+      if (value.is_none()) {
+        to.setZero();
+        return;
+      }
+      Block block;
+      read_numbers(value, block.data(), size * size,
+                   what + " jacobians' " + which + " (" + std::to_string(size) + " x " +
+                       std::to_string(size) + ")");
+      to = block;
+    };
+    read(pair[0], "stiffness", out.stiffness);
+    read(pair[1], "damping", out.damping);
+  }
+
+  /// Refuses user blocks that central differences contradict, naming the worst entry.
+  void check_against_differences(const ElementInput<Space, N>& in,
+                                 const ForceBlocks<Space, N>& given) const {
+    ForceBlocks<Space, N> differences;
+    difference_jacobians(*this, in, differences);
+    const auto compare = [&](const auto& user, const auto& reference, const char* which) {
+      const double scale = std::max(user.cwiseAbs().maxCoeff(), reference.cwiseAbs().maxCoeff());
+      Eigen::Index row = 0, col = 0;
+      const double worst = (user - reference).cwiseAbs().maxCoeff(&row, &col);
+      if (worst > 1e-4 * scale + 1e-9)
+        throw ModelError(name_, std::string("the ") + which + " block from jacobians() at (" +
+                                    std::to_string(row) + ", " + std::to_string(col) + ") is " +
+                                    to_text(user(row, col)) + " but central differences give " +
+                                    to_text(reference(row, col)) + " at t = " + to_text(in.t) +
+                                    "; see the jacobians parameter for the conventions");
+    };
+    compare(given.stiffness, differences.stiffness, "stiffness");
+    compare(given.damping, differences.damping, "damping");
+  }
+
   std::string name_;
   std::array<BodyId, N> bodies_;
   std::shared_ptr<Callable<Space>> function_;
+  std::shared_ptr<Callable<Space>> jacobians_;  // null: none given
   bool difference_jacobians_ = true;
+  // Whether the user's blocks were compared with differences (shared by the copies of a model).
+  std::shared_ptr<std::atomic<bool>> checked_ = std::make_shared<std::atomic<bool>>(false);
 };
 static_assert(StatelessForce<UserForceT<Spatial, 1>> && StatelessForce<UserForceT<Spatial, 2>>);
 static_assert(StatelessForce<UserForceT<Planar, 1>> && StatelessForce<UserForceT<Planar, 2>>);

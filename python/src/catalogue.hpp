@@ -273,17 +273,23 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
     py::object function = reader.template get<py::object>("function");
     const bool differences =
         !values.contains("difference_jacobians") || parameter<bool>(reader, "difference_jacobians");
+    py::object jacobians = reader.template get<py::object>("jacobians");
     reader.refuse_unread();
     const std::string what = "user_force '" + name + "'";
     if (bodies.size() != 1 && bodies.size() != 2)
       throw ModelError(what, "a user force acts on one or two bodies");
-    auto callable = std::make_shared<Callable<Space>>(std::move(function),
-                                                      static_cast<int>(bodies.size()), what);
-    if (bodies.size() == 1)
-      box.model.add(UserForceT<Space, 1>(name, {box.model.body(bodies[0])}, callable, differences));
+    const int count = static_cast<int>(bodies.size());
+    auto callable = std::make_shared<Callable<Space>>(std::move(function), count, what);
+    auto blocks = jacobians.is_none()
+                      ? nullptr
+                      : std::make_shared<Callable<Space>>(std::move(jacobians), count, what);
+    if (count == 1)
+      box.model.add(
+          UserForceT<Space, 1>(name, {box.model.body(bodies[0])}, callable, differences, blocks));
     else
-      box.model.add(UserForceT<Space, 2>(
-          name, {box.model.body(bodies[0]), box.model.body(bodies[1])}, callable, differences));
+      box.model.add(UserForceT<Space, 2>(name,
+                                         {box.model.body(bodies[0]), box.model.body(bodies[1])},
+                                         callable, differences, blocks));
   }
 };
 

@@ -281,6 +281,67 @@ def test_two_body_user_force_matches_the_cpp_tsda():
     assert r_t[-1] > 0
 
 
+def stiff_pair(kind, k=2e6, jacobians=None):
+    """Two bodies joined at their centres by a stiff spring (k h^2 / m = 2 at h = 1e-3), in C++
+    (tsda) or in Python with the given jacobians function."""
+    m = odyn.Model()
+    m.add_body(name="a", mass=1.0, inertia=[0.1] * 3, position=[-0.6, 0, 0])
+    m.add_body(name="b", mass=2.0, inertia=[0.1] * 3, position=[0.601, 0, 0],
+               linear_velocity=[0, 0.5, 0])
+    if kind == "tsda":
+        m.add_tsda(name="spring", body_a="a", point_a=[0, 0, 0], body_b="b",
+                   point_b=[0, 0, 0], stiffness=k, free_length=1.2)
+        return m
+
+    def spring(t, a, b):
+        d = np.asarray(b.position) - np.asarray(a.position)
+        length = np.linalg.norm(d)
+        f = k * (length - 1.2) * d / length  # pulls a towards b
+        return [[*f, 0, 0, 0], [*(-f), 0, 0, 0]]
+    m.add_user_force(name="spring", bodies=["a", "b"], function=spring, jacobians=jacobians)
+    return m
+
+
+def test_python_force_supplies_its_own_stiffness_blocks():
+    # The spring's exact stiffness, -dQ/dq over (a, b): S = k (n n^T + (1 - L0 / L)(I - n n^T))
+    # on the centres' coordinates, +S on the diagonal blocks and -S off them.
+    k = 2e6
+    calls = []
+
+    def jacobians(t, a, b):
+        calls.append(t)
+        d = np.asarray(b.position) - np.asarray(a.position)
+        length = np.linalg.norm(d)
+        n = d / length
+        s = k * (np.outer(n, n) + (1 - 1.2 / length) * (np.eye(3) - np.outer(n, n)))
+        stiffness = np.zeros((12, 12))
+        stiffness[0:3, 0:3] = stiffness[6:9, 6:9] = s
+        stiffness[0:3, 6:9] = stiffness[6:9, 0:3] = -s
+        return stiffness, None
+
+    settings = dict(t_end=0.05, step=1e-3, output_interval=0.01, integrator="generalized-alpha")
+    ref = odyn.simulate(stiff_pair("tsda"), **settings)
+    py = odyn.simulate(stiff_pair("user_force", jacobians=jacobians), **settings)
+    assert len(calls) > 0
+    np.testing.assert_allclose(py.q, ref.q, atol=1e-9)
+    # The same Newton matrices: the same iterations.
+    assert py.statistics.newton_iterations == ref.statistics.newton_iterations
+
+    # Blocks that contradict the force (the sign convention turned round) are refused at the
+    # first Newton matrix, naming the force and the entry.
+    def wrong(t, a, b):
+        stiffness, damping = jacobians(t, a, b)
+        return -stiffness, damping
+    with pytest.raises(odyn.ModelError, match="spring: the stiffness block from jacobians.. at "
+                       r"\(0, 0\) is -2"):
+        odyn.simulate(stiff_pair("user_force", jacobians=wrong), **settings)
+    with pytest.raises(TypeError, match="jacobians must return .stiffness, damping."):
+        odyn.simulate(stiff_pair("user_force", jacobians=lambda t, a, b: 1.0), **settings)
+    with pytest.raises(TypeError, match=r"jacobians' stiffness \(12 x 12\).*144 numbers"):
+        odyn.simulate(stiff_pair("user_force", jacobians=lambda t, a, b: (np.eye(6), None)),
+                      **settings)
+
+
 def rotor(kind, k=4.0, c=0.0, actuator=None):
     m = odyn.Model()
     m.add_body(name="rotor", mass=1.0, inertia=[0.5, 0.5, 1.0], angular_velocity=[0, 0, 1.0])

@@ -41,7 +41,7 @@ struct ParameterKind {
 };
 
 /// Every kind a description may use. A vector's, a wrench's or a matrix's default 0 is zero.
-inline constexpr std::array<ParameterKind, 19> parameter_kinds{{
+inline constexpr std::array<ParameterKind, 20> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
@@ -63,6 +63,7 @@ inline constexpr std::array<ParameterKind, 19> parameter_kinds{{
      "returning one"},
     {"optional_callable", "a function f(t, x, x') returning a number, or null for none"},
     {"callable", "a Python function"},
+    {"optional_function", "a Python function, or null for none"},
     {"wrench",
      "a force then a torque, in the element's axes: 6 numbers in space, 3 in the plane (fx, fy, "
      "torque)"},
