@@ -51,6 +51,12 @@ struct BushingLaw {
   using Matrix = Eigen::Matrix<double, N, N>;
   using Function = std::function<Vector(double t, const Vector& x, const Vector& rate)>;
 
+  /// A displacement x and its rate x', the law's arguments.
+  struct Displacement {
+    Vector x;
+    Vector rate;
+  };
+
   Matrix stiffness = Matrix::Zero();  // K
   Matrix damping = Matrix::Zero();    // C
   Vector preload = Vector::Zero();
