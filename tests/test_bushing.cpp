@@ -48,6 +48,17 @@ Matrix3d random_rotation(std::mt19937& random, double largest_angle) {
   return Eigen::AngleAxisd(largest_angle * uniform(random), axis).toRotationMatrix();
 }
 
+/// dop853 at 1e-12 over 1.5 periods of a mode at angular frequency omega, 16 outputs a period.
+odyn::DynamicsSettings mode_run(double omega) {
+  odyn::DynamicsSettings settings;
+  settings.integrator = "dop853";
+  settings.rtol = settings.atol = 1e-12;
+  const double period = 2.0 * std::numbers::pi / omega;
+  settings.t_end = 1.5 * period;
+  settings.output_interval = period / 16.0;
+  return settings;
+}
+
 // --- Spatial: force = -grad(energy), damper power --------------------------------------------
 
 /// The bushing's energy written out from two frames: d and theta with Eigen's angle-axis.
@@ -213,13 +224,8 @@ TEST_CASE("A body on an offset, coupled spatial bushing vibrates in its six anal
     const BodyId b = model.add_body(body);
     model.add(sp::Bushing("mount", odyn::ground, on_ground, b, on_b, law));
     odyn::Workspace<sp::DefaultModel> ws(model);
-    odyn::DynamicsSettings settings;
-    settings.integrator = "dop853";
+    odyn::DynamicsSettings settings = mode_run(omega);
     settings.coordinates = "absolute";
-    settings.rtol = settings.atol = 1e-12;
-    const double period = 2.0 * std::numbers::pi / omega;
-    settings.t_end = 1.5 * period;
-    settings.output_interval = period / 16.0;
     double worst = 0.0;
     odyn::simulate(model, ws, settings, [&](const auto& w) {
       Vector6d motion;
@@ -405,12 +411,7 @@ TEST_CASE("Planar bushing: energy's gradient, and the three modes of an offset m
     const BodyId b = model.add_body(body);
     model.add(pl::Bushing("mount", odyn::ground, on_ground, b, on_b, law));
     odyn::Workspace<pl::DefaultModel> ws(model);
-    odyn::DynamicsSettings settings;
-    settings.integrator = "dop853";
-    settings.rtol = settings.atol = 1e-12;
-    const double period = 2.0 * std::numbers::pi / omega;
-    settings.t_end = 1.5 * period;
-    settings.output_interval = period / 16.0;
+    const odyn::DynamicsSettings settings = mode_run(omega);
     double worst = 0.0;
     odyn::simulate(model, ws, settings, [&](const auto& w) {
       const Vector3d motion(w.q[0] - centre.x(), w.q[1] - centre.y(), w.q[2] - angle);
