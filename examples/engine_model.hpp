@@ -67,11 +67,17 @@ class GasForceT {
       {"kappa", "positive", "1.4", "", "ratio of specific heats"},
       {"p_comb", "nonnegative", "3.0e6", "Pa", "pressure rise of combustion"},
   }};
+  static constexpr std::array<odyn::Output, 4> output_list{{
+      {"crank_angle", "rad", "the cumulative crank angle"},
+      {"stroke", "", "0 intake, 1 compression, 2 power, 3 exhaust"},
+      {"pressure", "Pa", "the cylinder pressure"},
+      {"force", "N", "the gas force on the piston along the cylinder axis"},
+  }};
   static constexpr odyn::ElementDescription description{
       "engine_gas_force", "force",
       "The engine's Otto-cycle gas force on the piston along the cylinder axis (Z; y in the "
       "plane), the crank angle read from the crank's rotation; events at each half turn.",
-      parameter_list};
+      parameter_list, output_list};
   template <class Reader>
   static GasForceT from_parameters(Reader& r) {
     using odyn::parameter;
@@ -116,20 +122,28 @@ class GasForceT {
     out.force[1][up] = force(stroke(state.half_turn), in.body(1).position[up]);
   }
 
+  std::array<double, 4> outputs(const Input& in, const State& state) const {
+    const int s = stroke(state.half_turn);
+    const double z_piston = in.body(1).position[up];
+    return {angle(in, state), static_cast<double>(s), pressure(s, z_piston), force(s, z_piston)};
+  }
+
   /// The stroke (0 intake, 1 compression, 2 power, 3 exhaust) of a half-turn count.
   static int stroke(long half_turn) { return static_cast<int>(((half_turn % 4) + 4) % 4); }
 
-  /// F_z = -(P - P_atm) A, with the pressure law of the stroke.
-  double force(int stroke, double z_piston) const {
+  /// The cylinder pressure P in a stroke at a piston height.
+  double pressure(int stroke, double z_piston) const {
     const double area = p_.area(), v_c = p_.clearance_volume();
     const double volume = v_c + area * ((p_.r + p_.L) - z_piston);
-    double pressure = p_.p_atm;
-    if (stroke == 1)
-      pressure = p_.p_atm * std::pow((v_c + 2.0 * p_.r * area) / volume, p_.kappa);
-    else if (stroke == 2)
-      pressure =
-          (p_.p_atm * std::pow(p_.C, p_.kappa) + p_.p_comb) * std::pow(v_c / volume, p_.kappa);
-    return -(pressure - p_.p_atm) * area;
+    if (stroke == 1) return p_.p_atm * std::pow((v_c + 2.0 * p_.r * area) / volume, p_.kappa);
+    if (stroke == 2)
+      return (p_.p_atm * std::pow(p_.C, p_.kappa) + p_.p_comb) * std::pow(v_c / volume, p_.kappa);
+    return p_.p_atm;
+  }
+
+  /// F_z = -(P - P_atm) A, with the pressure law of the stroke.
+  double force(int stroke, double z_piston) const {
+    return -(pressure(stroke, z_piston) - p_.p_atm) * p_.area();
   }
 
  private:

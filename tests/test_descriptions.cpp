@@ -80,6 +80,7 @@ template <class E>
 void check_description() {
   static_assert(odyn::Described<E>);
   static_assert(odyn::is_well_formed(E::description));
+  static_assert(!odyn::ListsOutputsItDoesNotCompute<E>);
   const odyn::ElementDescription& d = E::description;
   INFO(d.type);
   InventedValues values(d);
@@ -91,6 +92,10 @@ void check_description() {
   for (const odyn::Parameter& p : d.parameters) {
     INFO(p.name);
     CHECK(std::string(p.doc).size() > 0);
+  }
+  for (const odyn::Output& o : d.outputs) {
+    INFO(o.name);
+    CHECK(std::string(o.doc).size() > 0);
   }
   if constexpr (requires { element.bodies(); }) {
     // Bodies in the described order: body_a (or crank) is 1, body_b (or piston) is 2.

@@ -3,6 +3,7 @@
 // own blocks of M v' + Phi_q^T lambda = Q, Phi(q, t) = 0. One include for everything.
 
 #include "odyn/analysis/assembly.hpp"
+#include "odyn/analysis/outputs.hpp"
 #include "odyn/analysis/reactions.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/model.hpp"

@@ -29,8 +29,8 @@ from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
-from .results import (AssemblyWarning, BodyHistory, Interrupted, PlanarBodyHistory, Reaction,
-                      RedundantConstraintsWarning, Result, Statistics, ToleranceWarning,
+from .results import (AssemblyWarning, BodyHistory, Interrupted, PlanarBodyHistory,
+                      PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics, ToleranceWarning,
                       assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
 
@@ -44,7 +44,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Interrupted",
-    "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "Reaction",
+    "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
     "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
     "ToleranceWarning", "assemble", "constant_velocity", "element_types", "frame", "harmonic",
     "integrators", "load", "loads", "motion_function", "planar_element_types", "polynomial",

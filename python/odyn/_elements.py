@@ -298,6 +298,8 @@ class SpatialElements(_Adds):
         damping (N s/m): c.
         free_length (m): the length at which the spring exerts no force.
         actuator (N): actuator(t, L, L') -> extra tension.
+
+        Outputs (Result.output(name)): length (m), rate (m/s), tension (N).
         """
         return self._add_given(
             "tsda", name=name, body_a=body_a, point_a=point_a, body_b=body_b, point_b=point_b,
@@ -320,6 +322,8 @@ class SpatialElements(_Adds):
         damping (N m s/rad): c.
         free_angle (rad): the angle at which the spring exerts no torque.
         actuator (N m): actuator(t, theta, theta') -> extra torque on b.
+
+        Outputs (Result.output(name)): angle (rad), rate (rad/s), torque (N m).
         """
         return self._add_given(
             "rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
@@ -345,6 +349,10 @@ class SpatialElements(_Adds):
         matrix.
         preload (N, N m): the force and torque on b at zero displacement.
         law (N, N m): law(t, x, x') -> an extra generalized force (a nonlinear bushing).
+
+        Outputs (Result.output(name)): x (m), y (m), z (m), rx (rad), ry (rad), rz (rad), vx (m/s),
+        vy (m/s), vz (m/s), wx (rad/s), wy (rad/s), wz (rad/s), fx (N), fy (N), fz (N), tx (N m),
+        ty (N m), tz (N m).
         """
         return self._add_given(
             "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
@@ -367,6 +375,8 @@ class SpatialElements(_Adds):
         p_atm (Pa): atmospheric pressure.
         kappa: ratio of specific heats.
         p_comb (Pa): pressure rise of combustion.
+
+        Outputs (Result.output(name)): crank_angle (rad), stroke, pressure (Pa), force (N).
         """
         return self._add_given(
             "engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D, C=C,
@@ -560,6 +570,8 @@ class PlanarElements(_Adds):
         damping (N s/m): c.
         free_length (m): the length at which the spring exerts no force.
         actuator (N): actuator(t, L, L') -> extra tension.
+
+        Outputs (Result.output(name)): length (m), rate (m/s), tension (N).
         """
         return self._add_given(
             "tsda", name=name, body_a=body_a, point_a=point_a, body_b=body_b, point_b=point_b,
@@ -582,6 +594,8 @@ class PlanarElements(_Adds):
         damping (N m s/rad): c.
         free_angle (rad): the angle at which the spring exerts no torque.
         actuator (N m): actuator(t, theta, theta') -> extra torque on b.
+
+        Outputs (Result.output(name)): angle (rad), rate (rad/s), torque (N m).
         """
         return self._add_given(
             "rsda", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
@@ -607,6 +621,9 @@ class PlanarElements(_Adds):
         matrix.
         preload (N, N m): the force and torque on b at zero displacement.
         law (N, N m): law(t, x, x') -> an extra generalized force (a nonlinear bushing).
+
+        Outputs (Result.output(name)): x (m), y (m), rz (rad), vx (m/s), vy (m/s), wz (rad/s), fx
+        (N), fy (N), tz (N m).
         """
         return self._add_given(
             "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
@@ -629,6 +646,8 @@ class PlanarElements(_Adds):
         p_atm (Pa): atmospheric pressure.
         kappa: ratio of specific heats.
         p_comb (Pa): pressure rise of combustion.
+
+        Outputs (Result.output(name)): crank_angle (rad), stroke, pressure (Pa), force (N).
         """
         return self._add_given(
             "engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D, C=C,

@@ -122,6 +122,11 @@ def _method(element: Mapping[str, Any], space: str) -> List[str]:
     for p in element["parameters"]:
         unit = f" ({p['unit']})" if p["unit"] else ""
         lines += _wrap(f"{p['name']}{unit}: {p['doc']}.", "        ")
+    if element["outputs"]:
+        listed = ", ".join(f"{o['name']} ({o['unit']})" if o["unit"] else o["name"]
+                           for o in element["outputs"])
+        lines.append("")
+        lines += _wrap(f"Outputs (Result.output(name)): {listed}.", "        ")
     lines.append('        """')
     call = ", ".join(f"{p['name']}={p['name']}" for p in element["parameters"])
     statement = f'        return self._add_given("{element["type"]}", {call})'
@@ -187,11 +192,13 @@ def elements_markdown() -> str:
         "",
         "1. Write its header: the blocks (see the README's *Writing an element*), then",
         "   `static constexpr ElementDescription description{type, category, summary, "
-        "parameters}` and `template <class Reader> static E from_parameters(Reader& r)`, "
-        "which builds it with `parameter<T>(r, \"key\")` for each described key (the lists "
+        "parameters, outputs}` and `template <class Reader> static E from_parameters(Reader& "
+        "r)`, which builds it with `parameter<T>(r, \"key\")` for each described key (the lists "
         "in `include/odyn/core/parameter_blocks.hpp` cover two bodies with frames or points, "
         "drivers and spring laws; `include/odyn/spatial/joint_primitives.hpp` is a short "
-        "example).",
+        "example). An element with outputs lists them (`outputs`, optional) and computes them "
+        "in `outputs(in)` (`include/odyn/core/outputs.hpp`; `include/odyn/forces/tsda.hpp` is "
+        "an example).",
         "2. Register it: add the type to `odyn::spatial::DefaultModel` or "
         "`odyn::planar::DefaultModel` and to the matching model type of the Python bindings "
         "(`python/src/bindings.hpp`; a static_assert there fails until it holds every type of "
@@ -220,6 +227,12 @@ def elements_markdown() -> str:
                 default = "required" if p["default"] is None else f"`{p['default']}`"
                 out.append(f"| `{p['name']}` | {p['kind']} | {default} | {p['unit']} | "
                            f"{_cell(p['doc'])} |")
+            if element["outputs"]:
+                out += ["", "Outputs, recorded at every output time (`result.output(name)`, "
+                        "or a scene output column `{\"element\": name, \"output\": ...}`):", "",
+                        "| output | unit | meaning |", "|---|---|---|"]
+                out += [f"| `{o['name']}` | {o['unit']} | {_cell(o['doc'])} |"
+                        for o in element["outputs"]]
     return "\n".join(out) + "\n"
 
 

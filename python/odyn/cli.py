@@ -252,6 +252,11 @@ def _elements(element_type: Optional[str], planar: bool) -> int:
         default = "required" if p["default"] is None else f"default {p['default']}"
         unit = f", {p['unit']}" if p["unit"] else ""
         print(f"  {p['name']:22} {p['kind']}{unit}; {default}. {p['doc']}")
+    if d["outputs"]:
+        print("outputs (scene column {\"element\": NAME, \"output\": ...}):")
+        for o in d["outputs"]:
+            unit = f" ({o['unit']})" if o["unit"] else ""
+            print(f"  {o['name']:22} {o['doc'] or '-'}{unit}")
     return 0
 
 

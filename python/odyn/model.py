@@ -74,7 +74,8 @@ def motion_function(position: Callable[[float], float], velocity: Callable[[floa
 
 
 class BaseModel:
-    """Bodies and elements, each with a unique name. The ground is the body named "ground".
+    """Bodies, elements and points, each with a unique name. The ground is the body named
+    "ground".
 
     Every ``add_*`` method checks its arguments, then adds the element to the compiled model;
     errors (`odyn.ModelError`, `odyn.SceneError`) name the element and the offending value.
@@ -93,9 +94,12 @@ class BaseModel:
         self._elements: Dict[str, Tuple[str, Dict[str, Any], Dict[str, Any]]] = {}
         # name -> (type, normalized parameters): what check_element resolves drivers against.
         self._checked: Dict[str, Tuple[str, Dict[str, Any]]] = {}
+        # name -> {"name", "body", "at"}: the named points (markers), in the order added.
+        self._points: Dict[str, Dict[str, Any]] = {}
 
     def _add_body(self, params: Mapping[str, Any], where: str) -> str:
-        body = _schema.check_body(params, where, _schema.Names(self._body_index, self._elements),
+        body = _schema.check_body(params, where,
+                                  _schema.Names(self._body_index, self._elements, self._points),
                                   self.space)
         try:
             self._core.add_body(body)
@@ -129,6 +133,9 @@ class BaseModel:
                          "one of " + ", ".join(catalogue))
         checked = _schema.check_element(kind, params, where, self._body_index, self._checked,
                                         self.space)
+        if checked["name"] in self._points:
+            _schema.fail(f"{where}.name", f"the name '{checked['name']}' is already used (by a "
+                         "point); names must be unique")
         try:
             self._core.add_element(kind, checked)
         except _core.ModelError as e:
@@ -136,6 +143,42 @@ class BaseModel:
         self._elements[checked["name"]] = (kind, checked, dict(params))
         self._checked[checked["name"]] = (kind, checked)
         return checked["name"]
+
+    # --- points ----------------------------------------------------------------------------
+    def add_point(self, name: str, body: str, at: Optional[Vector] = None) -> str:
+        """Adds a named point (a marker) fixed on a body, at `at` in body coordinates (default:
+        the origin, the body's centre of mass); returns its name. Results give its position,
+        velocity and acceleration (`Result.point`) and its motion relative to another point
+        (`Result.relative`); scene files list points under "points" and name them in outputs."""
+        return self._add_point({"name": name, "body": body,
+                                **({} if at is None else {"at": at})}, f"point '{name}'")
+
+    def _add_point(self, params: Mapping[str, Any], where: str) -> str:
+        dim = 2 if self.space == "planar" else 3
+        d = _schema.check_keys(params, where, ("name", "body", "at"), ("name", "body"))
+        name = _schema.check_name(d["name"], f"{where}.name")
+        if name in _schema.Names(self._body_index, self._elements, self._points):
+            _schema.fail(f"{where}.name", f"the name '{name}' is already used; names must be "
+                         "unique")
+        body = _schema._body(d["body"], f"{where}.body", self._body_index)
+        at = _schema.check_vector(d.get("at", [0.0] * dim), f"{where}.at", dim)
+        self._points[name] = {"name": name, "body": body, "at": at}
+        return name
+
+    @property
+    def point_names(self) -> List[str]:
+        return list(self._points)
+
+    def point(self, name: str) -> Dict[str, Any]:
+        """The point's {"name", "body", "at"}."""
+        if name not in self._points:
+            raise SceneError(f"{name}: no point of that name in the model"
+                             + (f"; points: {', '.join(self._points)}" if self._points else ""))
+        return dict(self._points[name])
+
+    def _point_table(self) -> Dict[str, Tuple[int, List[float]]]:
+        """name -> (body index, 0 for the ground; point in body coordinates), for results."""
+        return {n: (self._body_index[p["body"]], p["at"]) for n, p in self._points.items()}
 
     # --- what is in it ----------------------------------------------------------------------
     @property

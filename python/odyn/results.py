@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import warnings
-from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -108,13 +108,21 @@ class BodyHistory(NamedTuple):
     angular_acceleration: np.ndarray  # (n, 3) body axes
 
 
+class PointHistory(NamedTuple):
+    """A point's motion (or one point's relative to another), one row per output time."""
+    position: np.ndarray      # (n, 3); planar (n, 2)
+    velocity: np.ndarray      # (n, 3); planar (n, 2)
+    acceleration: np.ndarray  # (n, 3); planar (n, 2)
+
+
 class Result:
     """Outputs of an analysis, one row per output time.
 
     Arrays: t (n), q (n x 7 nb; planar n x 3 nb), v and vdot (n x 6 nb; planar n x 3 nb),
     lambda_ (n x m), kinetic_energy, potential_energy, total_energy, phi_norm (|Phi|),
     phid_norm (|Phi_q v + Phi_t|).
-    By name: body(name), reaction(joint, side, axes), multipliers(joint), state(element).
+    By name: body(name), point(name), relative(point, to, axes), reaction(joint, side, axes),
+    multipliers(joint), output(element, name), state(element).
     statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
     early); summary: the same as a dict, with the assembly report.
     """
@@ -140,6 +148,7 @@ class Result:
             self.summary["assembly"] if self.summary else None)
         self.interrupted = interrupted
         self._bodies: List[str] = list(data["bodies"])
+        self._points: Dict[str, Tuple[int, List[float]]] = dict(data.get("points", {}))
 
     def __len__(self) -> int:
         return len(self.t)
@@ -190,6 +199,80 @@ class Result:
         a = self.vdot[:, 6 * b:6 * b + 6]
         return BodyHistory(q[:, :3], q[:, 3:], v[:, :3], v[:, 3:], a[:, :3], a[:, 3:])
 
+    @property
+    def point_names(self) -> List[str]:
+        return list(self._points)
+
+    def _rotations(self, body: int) -> np.ndarray:
+        """(n, 3, 3) body-to-global rotations of body number `body` (planar: (n, 2, 2))."""
+        n = len(self.t)
+        if body == 0:
+            dim = 2 if self.space == "planar" else 3
+            return np.broadcast_to(np.eye(dim), (n, dim, dim))
+        if self.space == "planar":
+            c, s = np.cos(self.q[:, 3 * body - 1]), np.sin(self.q[:, 3 * body - 1])
+            return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+        w, x, y, z = (self.q[:, 7 * (body - 1) + 3 + i] for i in range(4))
+        return np.stack([
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ], -2)
+
+    def point(self, name: str) -> PointHistory:
+        """The global position, velocity and acceleration of a named point (`add_point`)."""
+        if name not in self._points:
+            raise KeyError(f"{name}: no point of that name; points: "
+                           + (", ".join(self._points) or "none (add them with add_point)"))
+        body, at = self._points[name]
+        local = np.asarray(at, dtype=float)
+        n, dim = len(self.t), len(local)
+        if body == 0:
+            zero = np.zeros((n, dim))
+            return PointHistory(np.tile(local, (n, 1)), zero, zero.copy())
+        arm = np.einsum("nij,j->ni", self._rotations(body), local)  # R s, global
+        if self.space == "planar":
+            q, v, a = (x[:, 3 * (body - 1):3 * body] for x in (self.q, self.v, self.vdot))
+            across = np.stack([-arm[:, 1], arm[:, 0]], -1)  # the arm turned a quarter
+            omega, alpha = v[:, 2:3], a[:, 2:3]
+            return PointHistory(q[:, :2] + arm, v[:, :2] + omega * across,
+                                a[:, :2] + alpha * across - omega ** 2 * arm)
+        rotations = self._rotations(body)
+        q = self.q[:, 7 * (body - 1):7 * (body - 1) + 3]
+        v = self.v[:, 6 * (body - 1):6 * body]
+        a = self.vdot[:, 6 * (body - 1):6 * body]
+        omega, alpha = v[:, 3:], a[:, 3:]  # body axes
+        spin = np.cross(omega, local)
+
+        def to_global(x: np.ndarray) -> np.ndarray:
+            return np.einsum("nij,nj->ni", rotations, x)
+        return PointHistory(q + arm, v[:, :3] + to_global(spin),
+                            a[:, :3] + to_global(np.cross(alpha, local) + np.cross(omega, spin)))
+
+    def relative(self, point: str, to: Optional[str] = None,
+                 axes: str = "global") -> PointHistory:
+        """The motion of `point` relative to the point `to` (None: the global origin): the
+        differences of their positions, velocities and accelerations, in global axes or in
+        the axes of the body named by `axes` (or of the body a point named by `axes` is on), as
+        ADAMS's DX, VX and ACCX with the ground as the frame of differentiation."""
+        motion = self.point(point)
+        if to is not None:
+            base = self.point(to)
+            motion = PointHistory(*(m - b for m, b in zip(motion, base)))
+        if axes == "global":
+            return motion
+        if axes in self._points:
+            body = self._points[axes][0]
+        elif axes == "ground":
+            body = 0
+        elif axes in self._bodies:
+            body = self._bodies.index(axes) + 1
+        else:
+            raise KeyError(f"axes {axes!r}: expected 'global', a body or a point; bodies: "
+                           + ", ".join(["ground"] + self._bodies))
+        rotations = self._rotations(body)
+        return PointHistory(*(np.einsum("nji,nj->ni", rotations, m) for m in motion))
+
     def reaction(self, joint: str, side: str = "b", axes: str = "global") -> Reaction:
         """Force and torque of the joint on body `side` ("a" or "b", exerted by the other),
         at the joint point, in "global" axes or the "joint" frame on that body."""
@@ -210,6 +293,26 @@ class Result:
         row, size = self._data["constraint_rows"][joint]
         return self.lambda_[:, row:row + size]
 
+    @property
+    def output_names(self) -> Dict[str, List[str]]:
+        """Each element that reports outputs, with their names."""
+        return {element: list(fields) for element, fields in self._data["outputs"].items()}
+
+    def output(self, element: str, name: Optional[str] = None) -> Any:
+        """An element's outputs (a spring's length, rate and tension; a bushing's displacement,
+        rate and force components; see `odyn elements TYPE`): all of them as a dict of arrays,
+        or the one named."""
+        outputs = self._data["outputs"]
+        if element not in outputs:
+            raise KeyError(f"{element}: no element of that name reports outputs; those that do: "
+                           + (", ".join(outputs) or "none"))
+        if name is None:
+            return dict(outputs[element])
+        if name not in outputs[element]:
+            raise KeyError(f"{element}: no output {name!r}; its outputs: "
+                           + ", ".join(outputs[element]))
+        return outputs[element][name]
+
     def state(self, element: str) -> Dict[str, np.ndarray]:
         """The discrete state of a stateful force: spatial rsda {angle}, engine_gas_force
         {theta, half_turn} (theta: the cumulative crank angle). A planar rsda keeps no state:
@@ -222,7 +325,8 @@ class Result:
     def save_npz(self, path: str) -> None:
         """Every array in one .npz file: t, q, v, vdot, lambda, energies, residuals,
         reaction/<joint> (n, side a/b, global/joint axes, force xyz + torque xyz),
-        state/<element>/<field> and bodies (their names, in the order of q and v)."""
+        state/<element>/<field>, output/<element>/<name>, point/<point>/<position, velocity or
+        acceleration> and bodies (their names, in the order of q and v)."""
         arrays = {key: self._data[key] for key in (
             "t", "q", "v", "vdot", "lambda", "kinetic_energy", "potential_energy", "phi_norm",
             "phid_norm")}
@@ -233,6 +337,12 @@ class Result:
         for name, fields in self._data["states"].items():
             for field, values in fields.items():
                 arrays[f"state/{name}/{field}"] = values
+        for name, fields in self._data["outputs"].items():
+            for field, values in fields.items():
+                arrays[f"output/{name}/{field}"] = values
+        for name in self._points:
+            for field, values in self.point(name)._asdict().items():
+                arrays[f"point/{name}/{field}"] = values
         np.savez(path, **arrays)  # type: ignore[arg-type]
 
     def energy_drift(self) -> float:
@@ -317,6 +427,7 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
         "assembly_tolerance": tolerance, "assembly_max_iterations": max_iterations,
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
+    data["points"] = model._point_table()
     result = Result(data)
     _warn(result)
     return result
@@ -401,6 +512,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
     data = _core.simulate(model._core, settings, progress)
+    data["points"] = model._point_table()
     error = data.pop("error")
     if error is None:
         result = Result(data)

@@ -10,6 +10,7 @@
       "drivers": [{"type": "revolute_driver", "name": "motor", "joint": "bearing",
                    "motion": {"type": "constant_velocity", "rate": 10.0}}],
       "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
+      "points":  [{"name": "pin", "body": "crank", "at": [0, 0.05, 0]}],   (markers)
       "analysis": {"t_end": 1.0, "output_interval": 1e-3},   (+ integrator, rho_inf, step,
                    rtol, atol, max_step, adaptive, newton_rtol, newton_atol,
                    constraint_tolerance, max_iterations, projection_tolerance, order,
@@ -17,7 +18,11 @@
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
                    generalized-alpha when a step is given without rtol and atol)
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
-                   "component": "z"}, ...],
+                   "component": "z"},
+                  {"name": "pin_vx", "point": "pin", "quantity": "velocity", "component": "x"},
+                  (+ "relative_to": a point, "axes": "global", a body or a point; see
+                   Result.relative), {"name": "spring_force", "element": "spring",
+                   "output": "tension"} (see odyn elements TYPE), ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
     }
 
@@ -47,8 +52,8 @@ _SCENE_FORCES = tuple(t for t in _schema.FORCES if t != "user_force")
 SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _schema.DRIVERS,
                           "forces": _SCENE_FORCES} for space in SPACES}
 SECTIONS = SPACE_SECTIONS["spatial"]
-TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "analysis",
-            "outputs", "figures")
+TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "points",
+            "analysis", "outputs", "figures")
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 # Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
 # or generalized-alpha (rho_inf 0.9) when a step is given without tolerances.
@@ -63,6 +68,7 @@ BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_veloci
 PLANAR_BODY_QUANTITIES = ("position", "angle", "linear_velocity", "angular_velocity",
                           "linear_acceleration", "angular_acceleration")
 PLANAR_SCALARS = ("angle", "angular_velocity", "angular_acceleration", "torque")
+POINT_QUANTITIES = ("position", "velocity", "acceleration")
 GLOBAL_QUANTITIES = ("phi_norm", "phid_norm", "kinetic_energy", "potential_energy",
                      "total_energy")
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
@@ -113,6 +119,8 @@ class Scene:
                 if kind in kinds:
                     entries.append({"type": kind, **_plain(params, f"{section}: '{name}'")})
             out[section] = entries
+        if self.model._points:
+            out["points"] = [dict(p) for p in self.model._points.values()]
         out["analysis"] = dict(self.analysis)
         out["outputs"] = [dict(o) for o in self.outputs]
         out["figures"] = [dict(f) for f in self.figures]
@@ -222,6 +230,29 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
         check_choice(d["axes"], f"{where}.axes", ("global", "joint"))
         check_choice(d["quantity"], f"{where}.quantity", ("force", "torque"))
         _check_component(d, where, d["quantity"], planar)
+    elif "point" in o:
+        d = check_keys(o, where, ("name", "point", "relative_to", "axes", "quantity", "component"),
+                       ("name", "point", "quantity"))
+        points = model.point_names
+        for key in ("point", "relative_to"):
+            if key in d and d[key] not in points:
+                fail(f"{where}.{key}", f"no point named {d[key]!r}; points: "
+                     + (", ".join(points) or "none (list them under 'points')"))
+        if "axes" in d:
+            check_choice(d["axes"], f"{where}.axes", ["global"] + model.body_names + points)
+        check_choice(d["quantity"], f"{where}.quantity", POINT_QUANTITIES)
+        _check_component(d, where, d["quantity"], planar)
+    elif "element" in o:
+        d = check_keys(o, where, ("name", "element", "output"), ("name", "element", "output"))
+        name = d["element"]
+        if name not in model.element_names:
+            fail(f"{where}.element", f"no element named {name!r}")
+        kind = model.element_type(name)
+        outputs = [x["name"] for x in
+                   _schema.DESCRIPTIONS[model.space].get(kind, {}).get("outputs", [])]
+        if not outputs:
+            fail(f"{where}.element", f"'{name}' ({kind}) reports no outputs")
+        check_choice(d["output"], f"{where}.output", outputs)
     elif "state" in o:
         d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
         fields: Dict[str, Sequence[str]] = {"engine_gas_force": ("theta", "half_turn")}
@@ -267,6 +298,11 @@ def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
         r = result.reaction(spec["reaction"], spec.get("side", "b"), spec.get("axes", "global"))
         values = getattr(r, spec["quantity"])
         return values if values.ndim == 1 else values[:, COMPONENTS[spec["component"]]]
+    if "point" in spec:
+        motion = result.relative(spec["point"], spec.get("relative_to"), spec.get("axes", "global"))
+        return getattr(motion, spec["quantity"])[:, COMPONENTS[spec["component"]]]
+    if "element" in spec:
+        return result.output(spec["element"], spec["output"])
     if "state" in spec:
         return result.state(spec["state"])[spec["field"]]
     return result[spec["quantity"]]
@@ -316,6 +352,13 @@ def from_dict(d: Any, where: str = "") -> Scene:
                 fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "
                      f"{', '.join(kinds)}")
             model._add(kind, {k: v for k, v in e.items() if k != "type"}, w)
+    points = d.get("points", [])
+    if not isinstance(points, list):
+        fail(f"{prefix}points", f"expected a list, got {type(points).__name__}")
+    for i, p in enumerate(points):
+        if not isinstance(p, Mapping):
+            _not_object(p, f"{prefix}points[{i}]")
+        model._add_point(p, f"{prefix}points[{i}]")
     description = d.get("description", "")
     if not isinstance(description, str):
         fail(f"{prefix}description", "expected a string")

@@ -1,9 +1,10 @@
 #pragma once
 // odyn._core: assembly and dynamic analysis, for either model of the bindings (instantiated in
 // analyses.cpp and analyses_planar.cpp). A run releases the GIL; at every output time it
-// records the state, the energies, the residuals, every constraint's reactions and every
-// stateful force's state, then briefly takes the GIL to let Python handle signals (Ctrl-C) and
-// report progress. A run that stops early keeps what it recorded.
+// records the state, the energies, the residuals, every constraint's reactions, every stateful
+// force's state and every element's outputs (core/outputs.hpp), then briefly takes the GIL to let
+// Python handle signals (Ctrl-C) and report progress. A run that stops early keeps what it
+// recorded.
 
 #include <Python.h>
 
@@ -103,9 +104,15 @@ class Recorder {
         } else if constexpr (StatefulForce<E>) {
           if (!state_fields<E>().empty()) stateful_.push_back({pool[i].name(), state_fields<E>()});
         }
+        if constexpr (HasOutputs<E>) {
+          std::vector<std::string> names;
+          for (const Output& o : E::description.outputs) names.emplace_back(o.name);
+          reporting_.push_back({pool[i].name(), std::move(names)});
+        }
       }
     });
     for (const auto& s : stateful_) state_width_ += static_cast<int>(s.fields.size());
+    for (const auto& r : reporting_) output_width_ += static_cast<int>(r.fields.size());
   }
 
   void record(const Workspace& ws) {
@@ -131,6 +138,10 @@ class Recorder {
             }
         } else if constexpr (StatefulForce<E>) {
           write_state(std::get<type>(ws.states)[i], states_);
+        }
+        if constexpr (HasOutputs<E>) {
+          const auto values = element_outputs(model_, ws, Handle<E>{i});
+          outputs_.insert(outputs_.end(), values.begin(), values.end());
         }
       }
     });
@@ -170,20 +181,8 @@ class Recorder {
     }
     out["reactions"] = reactions;
     out["constraint_rows"] = rows;
-    py::dict states;
-    int column = 0;
-    for (const auto& s : stateful_) {
-      py::dict fields;
-      for (const auto& field : s.fields) {
-        py::array_t<double> values(static_cast<py::ssize_t>(rows_));
-        for (long k = 0; k < rows_; ++k)
-          values.mutable_data()[k] = states_[static_cast<std::size_t>(k * state_width_ + column)];
-        fields[py::str(field)] = values;
-        ++column;
-      }
-      states[py::str(s.name)] = fields;
-    }
-    out["states"] = states;
+    out["states"] = by_field(stateful_, states_, state_width_);
+    out["outputs"] = by_field(reporting_, outputs_, output_width_);
     return out;
   }
 
@@ -192,17 +191,37 @@ class Recorder {
     std::string name;
     int row, size;
   };
-  struct StateInfo {
+  /// An element's recorded fields (a state's or its outputs), `width` numbers per row in all.
+  struct FieldInfo {
     std::string name;
     std::vector<std::string> fields;
   };
+
+  /// {element: {field: array over the outputs}} from rows of `width` numbers.
+  py::dict by_field(const std::vector<FieldInfo>& elements, const std::vector<double>& data,
+                    int width) const {
+    py::dict out;
+    int column = 0;
+    for (const auto& e : elements) {
+      py::dict fields;
+      for (const auto& field : e.fields) {
+        py::array_t<double> values(static_cast<py::ssize_t>(rows_));
+        for (long k = 0; k < rows_; ++k)
+          values.mutable_data()[k] = data[static_cast<std::size_t>(k * width + column)];
+        fields[py::str(field)] = values;
+        ++column;
+      }
+      out[py::str(e.name)] = fields;
+    }
+    return out;
+  }
   const Model& model_;
   std::vector<ConstraintInfo> constraints_;
-  std::vector<StateInfo> stateful_;
-  int state_width_ = 0;
+  std::vector<FieldInfo> stateful_, reporting_;
+  int state_width_ = 0, output_width_ = 0;
   long rows_ = 0;
   std::vector<double> t_, q_, v_, vdot_, lambda_, phi_norm_, phid_norm_, kinetic_, potential_;
-  std::vector<double> reactions_, states_;
+  std::vector<double> reactions_, states_, outputs_;
 };
 
 inline py::dict assembly_report(const AssemblyReport& r) {

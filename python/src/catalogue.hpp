@@ -244,6 +244,8 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
   static void register_type(std::unordered_map<std::string, Adder>& out) {
     if constexpr (Described<E>) {
       static_assert(is_well_formed(E::description), "a parameter of unknown kind or twice named");
+      static_assert(!ListsOutputsItDoesNotCompute<E>,
+                    "the description lists outputs that outputs(in) does not return");
       if constexpr (IsUserForce<E>::value)
         out.emplace(E::description.type, &add_user_force);
       else

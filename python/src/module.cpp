@@ -268,7 +268,7 @@ py::object type_names() {
 
 /// The descriptions of the element types a model type can add, as plain Python values: a list
 /// of {type, category, summary, parameters: [{name, kind, default (JSON text or None), unit,
-/// doc}]}.
+/// doc}], outputs: [{name, unit, doc}]}.
 template <class M>
 py::list catalogue() {
   py::list out;
@@ -284,11 +284,20 @@ py::list catalogue() {
       entry["doc"] = p.doc;
       parameters.append(entry);
     }
+    py::list outputs;
+    for (const Output& o : d->outputs) {
+      py::dict entry;
+      entry["name"] = o.name;
+      entry["unit"] = o.unit;
+      entry["doc"] = o.doc;
+      outputs.append(entry);
+    }
     py::dict element;
     element["type"] = d->type;
     element["category"] = d->category;
     element["summary"] = d->summary;
     element["parameters"] = parameters;
+    element["outputs"] = outputs;
     out.append(element);
   }
   return out;

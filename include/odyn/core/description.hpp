@@ -26,12 +26,20 @@ struct Parameter {
   const char* doc;       // one line
 };
 
+/// One named output an element reports (core/outputs.hpp), as ADAMS's requests do.
+struct Output {
+  const char* name;  // as results, scene files and CSV columns call it
+  const char* unit;  // SI unit; "" for none
+  const char* doc;   // one line
+};
+
 /// What an element type tells the front ends about itself.
 struct ElementDescription {
   const char* type;      // its name in Python and scene files, "revolute"; unique in a space
   const char* category;  // "joint", "driver" or "force"
   const char* summary;   // one line: what it does (and its number of equations)
   std::span<const Parameter> parameters;
+  std::span<const Output> outputs = {};  // what outputs(in) returns, in order
 };
 
 /// A kind of parameter value, and how it reads in each space.
@@ -95,7 +103,8 @@ constexpr std::array<Parameter, N + M> join(const std::array<Parameter, N>& firs
   return out;
 }
 
-/// True if every parameter of the description has a known kind and a unique name.
+/// True if every parameter of the description has a known kind and a unique name, and every
+/// output a unique name.
 constexpr bool is_well_formed(const ElementDescription& description) {
   const auto same = [](const char* a, const char* b) {
     while (*a != '\0' && *a == *b) ++a, ++b;
@@ -106,6 +115,9 @@ constexpr bool is_well_formed(const ElementDescription& description) {
     for (std::size_t j = 0; j < i; ++j)
       if (same(description.parameters[i].name, description.parameters[j].name)) return false;
   }
+  for (std::size_t i = 0; i < description.outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (same(description.outputs[i].name, description.outputs[j].name)) return false;
   return true;
 }
 

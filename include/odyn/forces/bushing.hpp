@@ -7,6 +7,7 @@
 //     with_defaults(frame)                         the frame's axes left out made the body's
 //     displacement(pair, in) -> Law::Displacement  x and x' of frame b relative to frame a
 //     apply(pair, in, displacement, g, out)        the generalized forces of g on a and b
+//     outputs                                      x, x' and g, one output per component
 // Stiffness and damping blocks for implicit integrators come by central differences.
 
 #include <string>
@@ -32,7 +33,7 @@ class BushingT : public Geometry::Pair {
   static constexpr std::array<Parameter, 9> parameter_list =
       join(parameters::bushing_frames, parameters::bushing_law);
   static constexpr ElementDescription description{"bushing", "force", Geometry::summary,
-                                                  parameter_list};
+                                                  parameter_list, Geometry::outputs};
   template <class Reader>
   static BushingT from_parameters(Reader& r) {
     return parameters::from_frame_pair<BushingT, JointFrame>(r, Law::from_parameters(r));
@@ -60,6 +61,16 @@ class BushingT : public Geometry::Pair {
 
   double potential_energy(const Input& in) const {
     return law_.potential_energy(displacement(in).x);
+  }
+
+  /// x, x' and the law's g, component by component.
+  std::array<double, 3 * Geometry::components> outputs(const Input& in) const {
+    const Displacement x = displacement(in);
+    const typename Law::Vector g = law_.force(in.t, x.x, x.rate);
+    std::array<double, 3 * Geometry::components> out;
+    constexpr int n = Geometry::components;
+    for (int i = 0; i < n; ++i) out[i] = x.x[i], out[n + i] = x.rate[i], out[2 * n + i] = g[i];
+    return out;
   }
 
   const Law& law() const { return law_; }

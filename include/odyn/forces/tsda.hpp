@@ -32,11 +32,16 @@ class TsdaT {
 
   static constexpr std::array<Parameter, 9> parameter_list =
       join(parameters::point_pair, parameters::translational_spring);
+  static constexpr std::array<Output, 3> output_list{{
+      {"length", "m", "L, the distance between the points"},
+      {"rate", "m/s", "L', positive as the points move apart"},
+      {"tension", "N", "the tension, positive pulling the points together"},
+  }};
   static constexpr ElementDescription description{
       "tsda", "force",
       "Translational spring-damper-actuator: the tension k (L - free_length) + c L' + "
       "actuator(t, L, L') pulls the points together.",
-      parameter_list};
+      parameter_list, output_list};
   template <class Reader>
   static TsdaT from_parameters(Reader& r) {
     return parameters::from_point_pair<TsdaT, Vector>(
@@ -64,8 +69,7 @@ class TsdaT {
 
   void evaluate(const Input& in, ForceBlocks<Space, 2>& out) const {
     const Geometry g = geometry(in);
-    const double tension = p_.stiffness * (g.length - p_.free_length) + p_.damping * g.rate +
-                           (p_.actuator ? p_.actuator(in.t, g.length, g.rate) : 0.0);
+    const double tension = tension_at(in.t, g);
     // Tension pulls b towards a and a towards b.
     out.force[0] = g.jacobian_a.transpose() * (tension * g.direction);
     out.force[1] = -g.jacobian_b.transpose() * (tension * g.direction);
@@ -93,12 +97,21 @@ class TsdaT {
     return 0.5 * p_.stiffness * stretch * stretch;
   }
 
+  std::array<double, 3> outputs(const Input& in) const {
+    const Geometry g = geometry(in);
+    return {g.length, g.rate, tension_at(in.t, g)};
+  }
+
  private:
   struct Geometry {
     typename Space::PointJacobian jacobian_a, jacobian_b;
     Vector direction;  // unit, from a to b
     double length, rate;
   };
+  double tension_at(double t, const Geometry& g) const {
+    return p_.stiffness * (g.length - p_.free_length) + p_.damping * g.rate +
+           (p_.actuator ? p_.actuator(t, g.length, g.rate) : 0.0);
+  }
   Geometry geometry(const Input& in) const {
     const Frame &a = in.body(0), &b = in.body(1);
     const Vector d = b.point(point_b_) - a.point(point_a_);

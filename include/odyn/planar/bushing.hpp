@@ -23,6 +23,17 @@ struct BushingGeometry {
   static constexpr const char* summary =
       "Three-component spring-damper between frame a and frame b: force and torque on b -K x - C "
       "x' + preload + law(t, x, x'), x = (b's origin in a's axes, joint angle).";
+  static constexpr std::array<Output, 9> outputs{{
+      {"x", "m", "b's frame origin in a's axes, x"},
+      {"y", "m", "b's frame origin in a's axes, y"},
+      {"rz", "rad", "the joint angle from a's axis to b's, counting turns"},
+      {"vx", "m/s", "the rate of x"},
+      {"vy", "m/s", "the rate of y"},
+      {"wz", "rad/s", "the rate of rz"},
+      {"fx", "N", "the law's force on b, x (a's axes)"},
+      {"fy", "N", "the law's force on b, y (a's axes)"},
+      {"tz", "N m", "the law's torque on b"},
+  }};
 
   static JointFrame with_defaults(JointFrame frame) {
     if (frame.axis.squaredNorm() == 0.0) frame.axis = Eigen::Vector2d::UnitX();

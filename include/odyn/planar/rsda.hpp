@@ -26,11 +26,16 @@ class Rsda : public PairJoint {
   /// The joint's points do not matter to the torque; only its axes (the angle's zero) do.
   static constexpr std::array<Parameter, 9> parameter_list =
       join(parameters::frame_pair, parameters::rotational_spring);
+  static constexpr std::array<Output, 3> output_list{{
+      {"angle", "rad", "theta, counting whole turns"},
+      {"rate", "rad/s", "theta'"},
+      {"torque", "N m", "the torque on b"},
+  }};
   static constexpr ElementDescription description{
       "rsda", "force",
       "Rotational spring-damper-actuator on the joint angle theta: torque on b -(k (theta - "
       "free_angle) + c theta') + actuator(t, theta, theta'), its opposite on a.",
-      parameter_list};
+      parameter_list, output_list};
   template <class Reader>
   static Rsda from_parameters(Reader& r) {
     return parameters::from_frame_pair<Rsda, JointFrame>(
@@ -47,9 +52,7 @@ class Rsda : public PairJoint {
       : Rsda(std::move(name), body_a, {}, body_b, {}, std::move(parameters)) {}
 
   void evaluate(const Input& in, ForceBlocks<Space, 2>& out) const {
-    const double theta = angle(in), theta_rate = angle_rate(in);
-    const double torque = -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
-                          (p_.actuator ? p_.actuator(in.t, theta, theta_rate) : 0.0);
+    const double torque = torque_at(in.t, angle(in), angle_rate(in));
     out.force[0] << 0.0, 0.0, -torque;
     out.force[1] << 0.0, 0.0, torque;
   }
@@ -66,7 +69,17 @@ class Rsda : public PairJoint {
     return 0.5 * p_.stiffness * stretch * stretch;
   }
 
+  std::array<double, 3> outputs(const Input& in) const {
+    const double theta = angle(in), theta_rate = angle_rate(in);
+    return {theta, theta_rate, torque_at(in.t, theta, theta_rate)};
+  }
+
  private:
+  double torque_at(double t, double theta, double theta_rate) const {
+    return -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
+           (p_.actuator ? p_.actuator(t, theta, theta_rate) : 0.0);
+  }
+
   Parameters p_;
 };
 static_assert(StatelessForce<Rsda>);

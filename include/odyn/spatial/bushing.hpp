@@ -29,6 +29,26 @@ struct BushingGeometry {
   static constexpr const char* summary =
       "Six-component spring-damper between frame a and frame b: force and torque on b -K x - C "
       "x' + preload + law(t, x, x'), x = (b's origin in a's axes, rotation vector).";
+  static constexpr std::array<Output, 18> outputs{{
+      {"x", "m", "b's frame origin in a's axes, x"},
+      {"y", "m", "b's frame origin in a's axes, y"},
+      {"z", "m", "b's frame origin in a's axes, z"},
+      {"rx", "rad", "the rotation vector from a's axes to b's, x (a's axes)"},
+      {"ry", "rad", "the rotation vector from a's axes to b's, y (a's axes)"},
+      {"rz", "rad", "the rotation vector from a's axes to b's, z (a's axes)"},
+      {"vx", "m/s", "the rate of x"},
+      {"vy", "m/s", "the rate of y"},
+      {"vz", "m/s", "the rate of z"},
+      {"wx", "rad/s", "the rate of rx"},
+      {"wy", "rad/s", "the rate of ry"},
+      {"wz", "rad/s", "the rate of rz"},
+      {"fx", "N", "the law's force on b, x (a's axes)"},
+      {"fy", "N", "the law's force on b, y (a's axes)"},
+      {"fz", "N", "the law's force on b, z (a's axes)"},
+      {"tx", "N m", "the law's torque component x (on b, a's axes, at small angles)"},
+      {"ty", "N m", "the law's torque component y (on b, a's axes, at small angles)"},
+      {"tz", "N m", "the law's torque component z (on b, a's axes, at small angles)"},
+  }};
 
   /// The frame with its reference filled in from the body's axes (see the file comment).
   static JointFrame with_defaults(JointFrame frame) {

@@ -31,11 +31,16 @@ class Rsda : public PairJoint {
 
   static constexpr std::array<Parameter, 9> parameter_list =
       join(parameters::frame_pair, parameters::rotational_spring);
+  static constexpr std::array<Output, 3> output_list{{
+      {"angle", "rad", "theta, counting whole turns"},
+      {"rate", "rad/s", "theta'"},
+      {"torque", "N m", "the torque on b about the axis"},
+  }};
   static constexpr ElementDescription description{
       "rsda", "force",
       "Rotational spring-damper-actuator about a's axis: torque on b -(k (theta - free_angle) + c "
       "theta') + actuator(t, theta, theta').",
-      parameter_list};
+      parameter_list, output_list};
   template <class Reader>
   static Rsda from_parameters(Reader& r) {
     return parameters::from_frame_pair<Rsda, JointFrame>(
@@ -68,8 +73,7 @@ class Rsda : public PairJoint {
     // load, runs in every residual evaluation.
     const bool needs_angle = p_.stiffness != 0.0 || static_cast<bool>(p_.actuator);
     const double theta = needs_angle ? angle(in, state) : 0.0;
-    const double torque = -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
-                          (p_.actuator ? p_.actuator(in.t, theta, theta_rate) : 0.0);
+    const double torque = torque_at(in.t, theta, theta_rate);
     out.force[0] = torque * e.head<6>();
     out.force[1] = torque * e.tail<6>();
   }
@@ -80,6 +84,11 @@ class Rsda : public PairJoint {
     out.damping = p_.damping * e * e.transpose();
   }
 
+  std::array<double, 3> outputs(const Input& in, const State& state) const {
+    const double theta = angle(in, state), theta_rate = rate(in);
+    return {theta, theta_rate, torque_at(in.t, theta, theta_rate)};
+  }
+
   /// The spring's energy at the unwrapped angle, so that it stays continuous past +-pi.
   double potential_energy(const Input& in, const State& state) const {
     const double stretch = angle(in, state) - p_.free_angle;
@@ -87,6 +96,10 @@ class Rsda : public PairJoint {
   }
 
  private:
+  double torque_at(double t, double theta, double theta_rate) const {
+    return -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
+           (p_.actuator ? p_.actuator(t, theta, theta_rate) : 0.0);
+  }
   double wrapped_angle(const Input& in) const {
     const auto &a = in.body(0), &b = in.body(1);
     const Eigen::Vector3d u_b = b.direction(on_b_.u);

@@ -1,0 +1,53 @@
+#pragma once
+// Element outputs, as ADAMS's requests: what an element reports about itself at any state (a
+// spring's length, rate and tension; a bushing's displacement, rate and force components). An
+// element type with outputs lists them in its description (`outputs`: names, units, docs) and
+// computes them, in that order, with
+//     std::array<double, K> outputs(const Input& in) const;                    or, stateful:
+//     std::array<double, K> outputs(const Input& in, const State& state) const;
+// where K is the length of the description's list. Results record them at every output time.
+
+#include <array>
+#include <cstddef>
+
+#include "odyn/core/description.hpp"
+#include "odyn/core/element.hpp"
+
+namespace odyn {
+
+/// The number of outputs a described element type lists.
+template <Described E>
+inline constexpr std::size_t num_outputs = E::description.outputs.size();
+
+template <class E>
+concept HasStatelessOutputs = Described<E> && requires(const E& e, const InputOf<E>& in) {
+  { e.outputs(in) } -> std::same_as<std::array<double, num_outputs<E>>>;
+};
+
+template <class E>
+concept HasStatefulOutputs =
+    Described<E> && StatefulForce<E> &&
+    requires(const E& e, const InputOf<E>& in, const typename E::State& state) {
+      { e.outputs(in, state) } -> std::same_as<std::array<double, num_outputs<E>>>;
+    };
+
+/// Optional: an element that reports outputs.
+template <class E>
+concept HasOutputs = (HasStatelessOutputs<E> || HasStatefulOutputs<E>) && num_outputs<E> > 0;
+
+/// True for a described element whose outputs() does not match its listed outputs (missing, or
+/// of another length): a mistake that would leave its outputs unrecorded, so front ends refuse it.
+template <class E>
+concept ListsOutputsItDoesNotCompute = Described<E> && num_outputs<E> > 0 && !HasOutputs<E>;
+
+/// The element's outputs at `in` (`state` is read by a stateful element only).
+template <HasOutputs E>
+std::array<double, num_outputs<E>> outputs_of(const E& element, const InputOf<E>& in,
+                                              const StateOf<E>& state) {
+  if constexpr (HasStatefulOutputs<E>)
+    return element.outputs(in, state);
+  else
+    return element.outputs(in);
+}
+
+}  // namespace odyn
