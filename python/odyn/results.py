@@ -249,28 +249,63 @@ class Result:
         return PointHistory(q + arm, v[:, :3] + to_global(spin),
                             a[:, :3] + to_global(np.cross(alpha, local) + np.cross(omega, spin)))
 
-    def relative(self, point: str, to: Optional[str] = None,
-                 axes: str = "global") -> PointHistory:
-        """The motion of `point` relative to the point `to` (None: the global origin): the
-        differences of their positions, velocities and accelerations, in global axes or in
-        the axes of the body named by `axes` (or of the body a point named by `axes` is on), as
-        ADAMS's DX, VX and ACCX with the ground as the frame of differentiation."""
+    def _body_of(self, name: str, what: str) -> int:
+        """The body number (0: the ground) of a body or a point named `name`."""
+        if name in self._points:
+            return self._points[name][0]
+        if name == "ground":
+            return 0
+        if name in self._bodies:
+            return self._bodies.index(name) + 1
+        expected = "'global', a body or a point" if what == "axes" else "a body or a point"
+        raise KeyError(f"{what} {name!r}: expected {expected}; bodies: "
+                       + ", ".join(["ground"] + self._bodies)
+                       + (f"; points: {', '.join(self._points)}" if self._points else ""))
+
+    def _turning(self, body: int) -> Tuple[np.ndarray, np.ndarray]:
+        """The global angular velocity and acceleration of a body: (n, 3) each, or (n, 1) in
+        the plane."""
+        n = len(self.t)
+        if body == 0:
+            width = 1 if self.space == "planar" else 3
+            return np.zeros((n, width)), np.zeros((n, width))
+        if self.space == "planar":
+            return self.v[:, 3 * body - 1:3 * body], self.vdot[:, 3 * body - 1:3 * body]
+        rotations = self._rotations(body)
+        omega = self.v[:, 6 * (body - 1) + 3:6 * body]
+        alpha = self.vdot[:, 6 * (body - 1) + 3:6 * body]
+        return (np.einsum("nij,nj->ni", rotations, omega),
+                np.einsum("nij,nj->ni", rotations, alpha))
+
+    def relative(self, point: str, to: Optional[str] = None, axes: str = "global",
+                 seen_from: str = "ground") -> PointHistory:
+        """The motion of `point` relative to the point `to` (None: the global origin), as
+        ADAMS's DX, VX and ACCX: the position of `point` from `to`, and its velocity and
+        acceleration as an observer on the body `seen_from` (the ground by default: then the
+        differences of the two points' velocities and accelerations) sees them, in global axes
+        or in the axes of the body named by `axes`. A body may also be named by a point on it."""
         motion = self.point(point)
         if to is not None:
             base = self.point(to)
             motion = PointHistory(*(m - b for m, b in zip(motion, base)))
+        frame = self._body_of(seen_from, "seen_from")
+        if frame != 0:
+            # d' and d'' as seen on a frame turning at W (global) with W' : v = d' - W x d,
+            # a = d'' - W' x d - 2 W x v - W x (W x d).
+            spin, spin_rate = self._turning(frame)
+            if self.space == "planar":
+                def cross(w: np.ndarray, x: np.ndarray) -> np.ndarray:
+                    return w * np.stack([-x[:, 1], x[:, 0]], -1)
+            else:
+                cross = np.cross
+            d = motion.position
+            velocity = motion.velocity - cross(spin, d)
+            acceleration = (motion.acceleration - cross(spin_rate, d) - 2 * cross(spin, velocity)
+                            - cross(spin, cross(spin, d)))
+            motion = PointHistory(d, velocity, acceleration)
         if axes == "global":
             return motion
-        if axes in self._points:
-            body = self._points[axes][0]
-        elif axes == "ground":
-            body = 0
-        elif axes in self._bodies:
-            body = self._bodies.index(axes) + 1
-        else:
-            raise KeyError(f"axes {axes!r}: expected 'global', a body or a point; bodies: "
-                           + ", ".join(["ground"] + self._bodies))
-        rotations = self._rotations(body)
+        rotations = self._rotations(self._body_of(axes, "axes"))
         return PointHistory(*(np.einsum("nji,nj->ni", rotations, m) for m in motion))
 
     def reaction(self, joint: str, side: str = "b", axes: str = "global") -> Reaction:

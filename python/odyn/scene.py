@@ -20,8 +20,8 @@
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"},
                   {"name": "pin_vx", "point": "pin", "quantity": "velocity", "component": "x"},
-                  (+ "relative_to": a point, "axes": "global", a body or a point; see
-                   Result.relative), {"name": "spring_force", "element": "spring",
+                  (+ "relative_to": a point, "axes": "global", a body or a point, "seen_from":
+                   a body or a point; see Result.relative), {"name": "spring_force", "element": "spring",
                    "output": "tension"} (see odyn elements TYPE), ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
     }
@@ -231,8 +231,8 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
         check_choice(d["quantity"], f"{where}.quantity", ("force", "torque"))
         _check_component(d, where, d["quantity"], planar)
     elif "point" in o:
-        d = check_keys(o, where, ("name", "point", "relative_to", "axes", "quantity", "component"),
-                       ("name", "point", "quantity"))
+        d = check_keys(o, where, ("name", "point", "relative_to", "axes", "seen_from", "quantity",
+                                  "component"), ("name", "point", "quantity"))
         points = model.point_names
         for key in ("point", "relative_to"):
             if key in d and d[key] not in points:
@@ -240,6 +240,8 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
                      + (", ".join(points) or "none (list them under 'points')"))
         if "axes" in d:
             check_choice(d["axes"], f"{where}.axes", ["global"] + model.body_names + points)
+        if "seen_from" in d:
+            check_choice(d["seen_from"], f"{where}.seen_from", model.body_names + points)
         check_choice(d["quantity"], f"{where}.quantity", POINT_QUANTITIES)
         _check_component(d, where, d["quantity"], planar)
     elif "element" in o:
@@ -299,7 +301,8 @@ def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
         values = getattr(r, spec["quantity"])
         return values if values.ndim == 1 else values[:, COMPONENTS[spec["component"]]]
     if "point" in spec:
-        motion = result.relative(spec["point"], spec.get("relative_to"), spec.get("axes", "global"))
+        motion = result.relative(spec["point"], spec.get("relative_to"), spec.get("axes", "global"),
+                                 spec.get("seen_from", "ground"))
         return getattr(motion, spec["quantity"])[:, COMPONENTS[spec["component"]]]
     if "element" in spec:
         return result.output(spec["element"], spec["output"])

@@ -73,6 +73,11 @@ def test_a_point_on_a_turning_rotor_follows_its_circle(space):
     offset = relative.position[0]
     spin = OMEGA * np.array([-offset[1], offset[0]] + ([0.0] if dim == 3 else []))
     np.testing.assert_allclose(relative.velocity, np.tile(spin, (len(r.t), 1)), atol=1e-8)
+    # Seen from the rotor itself, the rim neither moves nor accelerates.
+    on_rotor = r.relative("rim", "hub", axes="rotor", seen_from="rotor")
+    np.testing.assert_allclose(on_rotor.position, relative.position)
+    np.testing.assert_allclose(on_rotor.velocity, 0, atol=1e-8)
+    np.testing.assert_allclose(on_rotor.acceleration, 0, atol=1e-6)
     # The same axes named by a point on the rotor; the hub (on the ground) stands still.
     np.testing.assert_allclose(r.relative("rim", "hub", axes="rim").position, relative.position)
     np.testing.assert_allclose(r.point("hub").position, np.tile(hub, (len(r.t), 1)))
@@ -85,6 +90,30 @@ def test_a_point_on_a_turning_rotor_follows_its_circle(space):
     np.testing.assert_allclose(r.point("centre").velocity, body.linear_velocity)
     np.testing.assert_allclose(r.point("centre").acceleration, body.linear_acceleration)
     assert local == pytest.approx([0.3, -0.05, 0.1][:dim])
+
+
+def test_motion_seen_from_a_tumbling_body():
+    """A free body tumbling under no force (angular velocity about a non-principal axis), a
+    second body on a ground hinge turning at a constant rate; the second body's point as the
+    first body sees it, against differences of its position in the first body's axes."""
+    m = odyn.Model()
+    m.add_body(name="tumbler", mass=1.0, inertia=[0.1, 0.2, 0.3], position=[0.3, -0.2, 0.1],
+               linear_velocity=[0.2, 0.1, -0.3], angular_velocity=[3.0, 1.0, 4.0])
+    m.add_body(name="arm", mass=1.0, inertia=[0.01, 0.01, 0.01], position=[0.5, 0, 0],
+               angular_velocity=[0, 0, 2.0])
+    m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 0], [0, 0, 1]),
+                   body_b="arm", on_b=odyn.frame([-0.5, 0, 0], [0, 0, 1]))
+    m.add_point("tip", "arm", at=[0.5, 0.1, 0.05])
+    m.add_point("mark", "tumbler", at=[0.05, 0.1, -0.1])
+    dt = 1e-4
+    r = odyn.simulate(m, t_end=0.2, output_interval=dt, integrator="dop853", rtol=1e-12,
+                      atol=1e-12)
+    seen = r.relative("tip", "mark", axes="tumbler", seen_from="tumbler")
+    velocity = (seen.position[2:] - seen.position[:-2]) / (2 * dt)
+    acceleration = (seen.velocity[2:] - seen.velocity[:-2]) / (2 * dt)
+    assert np.max(np.abs(seen.acceleration)) > 5
+    np.testing.assert_allclose(seen.velocity[1:-1], velocity, atol=1e-5)
+    np.testing.assert_allclose(seen.acceleration[1:-1], acceleration, atol=1e-4)
 
 
 def spring_mass():
@@ -138,7 +167,8 @@ def scene_dict():
         "outputs": [{"name": "tension", "element": "spring", "output": "tension"},
                     {"name": "tip_z", "point": "tip", "quantity": "position", "component": "z"},
                     {"name": "tip_vz", "point": "tip", "relative_to": "origin",
-                     "axes": "mass", "quantity": "velocity", "component": "z"}],
+                     "axes": "mass", "seen_from": "mass", "quantity": "velocity",
+                     "component": "z"}],
     }
 
 
