@@ -4,7 +4,8 @@
 //   stiffness; its damper's power is -x'^T C x', with x' by differences along the motion;
 // - small vibrations of a body on an offset, coupled bushing follow the modes of the
 //   generalized eigenproblem (A^T K A) phi = w^2 M phi, A the linearized displacement map;
-// - a damped, preloaded, loaded mount against the closed-form damped oscillator;
+// - a damped, preloaded, loaded mount against the closed-form damped oscillator, its outputs
+//   (displacement, rate and force components) too;
 // - energy is conserved over a large motion; generalized-alpha with the blocks by differences
 //   converges to the same motion; bad matrices are refused by name.
 
@@ -257,7 +258,7 @@ TEST_CASE("A damped, preloaded bushing mount follows the closed-form damped osci
   sp::Body body{.name = "block", .mass = mass, .inertia = sp::Body::principal(0.01, 0.01, 0.01)};
   body.position = Vector3d(0.0, 0.0, z0);
   const BodyId b = model.add_body(body);
-  model.add(sp::Bushing("mount", odyn::ground, {}, b, {}, law));
+  const auto mount = model.add(sp::Bushing("mount", odyn::ground, {}, b, {}, law));
   model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
   odyn::Workspace<sp::DefaultModel> ws(model);
   odyn::DynamicsSettings settings;
@@ -267,14 +268,29 @@ TEST_CASE("A damped, preloaded bushing mount follows the closed-form damped osci
   settings.output_interval = 0.01;
   const double omega = std::sqrt(k / mass), zeta = c / (2.0 * std::sqrt(k * mass));
   const double omega_d = omega * std::sqrt(1.0 - zeta * zeta), rest = (preload - mass * g) / k;
-  double worst = 0.0;
+  const double decay = zeta * omega, ratio = zeta / std::sqrt(1.0 - zeta * zeta);
+  // The motion, and the mount's outputs (core/outputs.hpp): z, z' and the force along z, the
+  // other components at rest.
+  double worst = 0.0, worst_output = 0.0, worst_rate = 0.0, worst_force = 0.0;
   odyn::simulate(model, ws, settings, [&](const auto& w) {
-    const double z = rest + (z0 - rest) * std::exp(-zeta * omega * w.t) *
-                                (std::cos(omega_d * w.t) +
-                                 zeta / std::sqrt(1.0 - zeta * zeta) * std::sin(omega_d * w.t));
+    const double e = std::exp(-decay * w.t);
+    const double cs = std::cos(omega_d * w.t), sn = std::sin(omega_d * w.t);
+    const double z = rest + (z0 - rest) * e * (cs + ratio * sn);
+    const double z_rate = -(z0 - rest) * e * (omega * omega / omega_d) * sn;
     worst = std::max({worst, std::abs(w.q[2] - z), w.q.template head<2>().norm()});
+    const auto x = odyn::element_outputs(model, w, mount);
+    worst_rate = std::max(worst_rate, std::abs(x[8] - z_rate));
+    worst_force = std::max(worst_force, std::abs(x[14] - (preload - k * z - c * z_rate)));
+    worst_output = std::max(worst_output, std::abs(x[2] - z));
+    for (const std::size_t i : {0, 1, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 15, 16, 17})
+      worst_output = std::max(worst_output, std::abs(x[i]));
   });
   CHECK(worst < 1e-10);
+  CHECK(worst_output < 1e-9);
+  CHECK(worst_rate < 1e-8);
+  CHECK(worst_force < 1e-6);
+  CHECK(odyn::element_output(model, ws, "mount", "fz") ==
+        odyn::element_outputs(model, ws, mount)[14]);
 }
 
 TEST_CASE("Two bodies on coupled bushings keep their energy over a large motion", "[bushing]") {

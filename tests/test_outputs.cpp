@@ -4,8 +4,7 @@
 // - a damped rotor: a rotational damper's angle (counting many turns), rate and torque against
 //   the closed-form spin-down, in space (where the angle is unwrapped from a state) and in the
 //   plane;
-// - a mass on a damped, preloaded bushing: its displacement, rate and force components against
-//   the closed-form damped oscillator;
+// (a bushing's outputs are tested in test_bushing.cpp, on its damped oscillator);
 // - points on a spinning top and a planar pendulum: velocity and acceleration against central
 //   differences of the recorded positions and velocities;
 // - outputs by name, and the error naming the element's outputs for an unknown one.
@@ -113,48 +112,6 @@ TEST_CASE("A rotational damper's angle counts the turns of a spinning-down rotor
   CHECK(worst[0] < 1e-9 * spin.angle(1.0));
   CHECK(worst[1] < 1e-9 * spin.omega0);
   CHECK(worst[2] < 1e-9 * spin.damping * spin.omega0);
-}
-
-TEST_CASE("A bushing's displacement, rate and force components follow the damped oscillator",
-          "[outputs][bushing]") {
-  // A block on a damped, preloaded mount under gravity moves along z only:
-  // z = z* + (z0 - z*) e^(-zeta w t) (cos(w_d t) + zeta / sqrt(1 - zeta^2) sin(w_d t)),
-  // z* = (p - m g) / k, and the mount's force on the block is m z'' + m g.
-  const double mass = 2.0, k = 5e3, c = 8.0, preload = 30.0, g = 9.81, z0 = 0.004;
-  sp::Bushing::Law law;
-  law.stiffness.diagonal() << 1e5, 1e5, k, 1e3, 1e3, 1e3;
-  law.damping(2, 2) = c;
-  law.preload[2] = preload;
-  sp::DefaultModel model;
-  sp::Body body{.name = "block", .mass = mass, .inertia = sp::Body::principal(0.01, 0.01, 0.01)};
-  body.position = Vector3d(0.0, 0.0, z0);
-  const BodyId b = model.add_body(body);
-  const auto mount = model.add(sp::Bushing("mount", odyn::ground, {}, b, {}, law));
-  model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
-  const double omega = std::sqrt(k / mass), zeta = c / (2.0 * std::sqrt(k * mass));
-  const double omega_d = omega * std::sqrt(1.0 - zeta * zeta), rest = (preload - mass * g) / k;
-  const double decay = zeta * omega, ratio = zeta / std::sqrt(1.0 - zeta * zeta);
-  odyn::Workspace<sp::DefaultModel> ws(model);
-  double worst_z = 0.0, worst_rate = 0.0, worst_force = 0.0, worst_other = 0.0;
-  odyn::simulate(model, ws, tight_run(0.5, 0.01), [&](const auto& w) {
-    const auto x = odyn::element_outputs(model, w, mount);
-    const double t = w.t, e = std::exp(-decay * t);
-    const double cs = std::cos(omega_d * t), sn = std::sin(omega_d * t);
-    const double z = rest + (z0 - rest) * e * (cs + ratio * sn);
-    const double z_rate = -(z0 - rest) * e * (omega * omega / omega_d) * sn;
-    const double force = preload - k * (z - 0.0) - c * z_rate;  // = m (z'' + g)
-    worst_z = std::max(worst_z, std::abs(x[2] - z));
-    worst_rate = std::max(worst_rate, std::abs(x[8] - z_rate));
-    worst_force = std::max(worst_force, std::abs(x[14] - force));
-    for (const int i : {0, 1, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 15, 16, 17})
-      worst_other = std::max(worst_other, std::abs(x[static_cast<std::size_t>(i)]));
-  });
-  CHECK(worst_z < 1e-10);
-  CHECK(worst_rate < 1e-8);
-  CHECK(worst_force < 1e-6);
-  CHECK(worst_other < 1e-9);
-  CHECK(odyn::element_output(model, ws, "mount", "fz") ==
-        odyn::element_outputs(model, ws, mount)[14]);
 }
 
 /// Central differences over three successive outputs: the middle one's derivative.
