@@ -73,11 +73,18 @@ class GasForceT {
       {"pressure", "Pa", "the cylinder pressure"},
       {"force", "N", "the gas force on the piston along the cylinder axis"},
   }};
+  static constexpr std::array<odyn::Output, 2> state_list{{
+      {"theta", "rad", "the cumulative crank angle at the last accepted step"},
+      {"half_turn", "", "half turns completed (the stroke is half_turn mod 4)"},
+  }};
   static constexpr odyn::ElementDescription description{
-      "engine_gas_force", "force",
+      "engine_gas_force",
+      "force",
       "The engine's Otto-cycle gas force on the piston along the cylinder axis (Z; y in the "
       "plane), the crank angle read from the crank's rotation; events at each half turn.",
-      parameter_list, output_list};
+      parameter_list,
+      output_list,
+      state_list};
   template <class Reader>
   static GasForceT from_parameters(Reader& r) {
     using odyn::parameter;
@@ -92,6 +99,10 @@ class GasForceT {
 
   const std::string& name() const { return name_; }
   const std::array<odyn::BodyId, 2>& bodies() const { return bodies_; }
+
+  static std::array<double, 2> state_values(const State& state) {
+    return {state.theta, static_cast<double>(state.half_turn)};
+  }
 
   State initial_state(const Input& in) const {
     const double theta = wrapped_angle(in);

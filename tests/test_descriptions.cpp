@@ -81,6 +81,7 @@ void check_description() {
   static_assert(odyn::Described<E>);
   static_assert(odyn::is_well_formed(E::description));
   static_assert(!odyn::ListsOutputsItDoesNotCompute<E>);
+  static_assert(!odyn::ListsStateItDoesNotRecord<E>);
   const odyn::ElementDescription& d = E::description;
   INFO(d.type);
   InventedValues values(d);
@@ -93,10 +94,11 @@ void check_description() {
     INFO(p.name);
     CHECK(std::string(p.doc).size() > 0);
   }
-  for (const odyn::Output& o : d.outputs) {
-    INFO(o.name);
-    CHECK(std::string(o.doc).size() > 0);
-  }
+  for (const auto& list : {d.outputs, d.state_fields})
+    for (const odyn::Output& o : list) {
+      INFO(o.name);
+      CHECK(std::string(o.doc).size() > 0);
+    }
   if constexpr (requires { element.bodies(); }) {
     // Bodies in the described order: body_a (or crank) is 1, body_b (or piston) is 2.
     const auto& bodies = element.bodies();

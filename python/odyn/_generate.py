@@ -233,6 +233,11 @@ def elements_markdown() -> str:
                         "| output | unit | meaning |", "|---|---|---|"]
                 out += [f"| `{o['name']}` | {o['unit']} | {_cell(o['doc'])} |"
                         for o in element["outputs"]]
+            if element["state_fields"]:
+                out += ["", "State, recorded at every output time (`result.state(name)`):", "",
+                        "| field | unit | meaning |", "|---|---|---|"]
+                out += [f"| `{o['name']}` | {o['unit']} | {_cell(o['doc'])} |"
+                        for o in element["state_fields"]]
     return "\n".join(out) + "\n"
 
 

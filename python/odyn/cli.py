@@ -257,6 +257,11 @@ def _elements(element_type: Optional[str], planar: bool) -> int:
         for o in d["outputs"]:
             unit = f" ({o['unit']})" if o["unit"] else ""
             print(f"  {o['name']:22} {o['doc'] or '-'}{unit}")
+    if d["state_fields"]:
+        print("state (scene column {\"state\": NAME, \"field\": ...}):")
+        for o in d["state_fields"]:
+            unit = f" ({o['unit']})" if o["unit"] else ""
+            print(f"  {o['name']:22} {o['doc']}{unit}")
     return 0
 
 

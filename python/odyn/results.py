@@ -349,9 +349,9 @@ class Result:
         return outputs[element][name]
 
     def state(self, element: str) -> Dict[str, np.ndarray]:
-        """The discrete state of a stateful force: spatial rsda {angle}, engine_gas_force
-        {theta, half_turn} (theta: the cumulative crank angle). A planar rsda keeps no state:
-        its angle is a difference of body angles."""
+        """The discrete state of a stateful force at each output, field by field (see `odyn
+        elements TYPE`): spatial rsda {angle}, engine_gas_force {theta, half_turn}. A planar
+        rsda keeps no state: its angle is a difference of body angles."""
         if element not in self._data["states"]:
             raise KeyError(f"{element}: no stateful force of that name; stateful forces: "
                            + ", ".join(self._data["states"]))

@@ -257,9 +257,8 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
         check_choice(d["output"], f"{where}.output", outputs)
     elif "state" in o:
         d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
-        fields: Dict[str, Sequence[str]] = {"engine_gas_force": ("theta", "half_turn")}
-        if not planar:
-            fields["rsda"] = ("angle",)
+        fields = {t: [f["name"] for f in e["state_fields"]]
+                  for t, e in _schema.DESCRIPTIONS[model.space].items() if e["state_fields"]}
         name = d["state"]
         if name not in model.element_names or model.element_type(name) not in fields:
             fail(f"{where}.state", f"no stateful force ({', '.join(fields)}) named {name!r}")

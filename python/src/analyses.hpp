@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <exception>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,27 +58,6 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   return s;
 }
 
-/// The discrete state a stateful force exposes to Python: field names and values.
-template <class E>
-std::vector<std::string> state_fields() {
-  if constexpr (std::is_same_v<E, sp::Rsda>)
-    return {"angle"};
-  else if constexpr (std::is_same_v<E, EngineGasForce> || std::is_same_v<E, PlanarEngineGasForce>)
-    return {"theta", "half_turn"};
-  else
-    return {};
-}
-template <class State>
-void write_state(const State& state, std::vector<double>& out) {
-  if constexpr (std::is_same_v<State, sp::Rsda::State>) {
-    out.push_back(state.angle);
-  } else if constexpr (std::is_same_v<State, EngineGasForce::State> ||
-                       std::is_same_v<State, PlanarEngineGasForce::State>) {
-    out.push_back(state.theta);
-    out.push_back(static_cast<double>(state.half_turn));
-  }
-}
-
 inline py::array_t<double> to_array(const std::vector<double>& data, py::ssize_t rows,
                                     std::vector<py::ssize_t> shape_of_row = {}) {
   std::vector<py::ssize_t> shape{rows};
@@ -101,14 +81,11 @@ class Recorder {
         if constexpr (Constraint<E>) {
           constraints_.push_back(
               {pool[i].name(), model.row(Handle<E>{i}), static_cast<int>(E::num_equations)});
-        } else if constexpr (StatefulForce<E>) {
-          if (!state_fields<E>().empty()) stateful_.push_back({pool[i].name(), state_fields<E>()});
         }
-        if constexpr (HasOutputs<E>) {
-          std::vector<std::string> names;
-          for (const Output& o : E::description.outputs) names.emplace_back(o.name);
-          reporting_.push_back({pool[i].name(), std::move(names)});
-        }
+        if constexpr (RecordsState<E>)
+          stateful_.push_back({pool[i].name(), names_of(E::description.state_fields)});
+        if constexpr (HasOutputs<E>)
+          reporting_.push_back({pool[i].name(), names_of(E::description.outputs)});
       }
     });
     for (const auto& s : stateful_) state_width_ += static_cast<int>(s.fields.size());
@@ -136,8 +113,10 @@ class Recorder {
               reactions_.insert(reactions_.end(), w.force.begin(), w.force.end());
               reactions_.insert(reactions_.end(), w.torque.begin(), w.torque.end());
             }
-        } else if constexpr (StatefulForce<E>) {
-          write_state(std::get<type>(ws.states)[i], states_);
+        }
+        if constexpr (RecordsState<E>) {
+          const auto values = E::state_values(std::get<type>(ws.states)[i]);
+          states_.insert(states_.end(), values.begin(), values.end());
         }
         if constexpr (HasOutputs<E>) {
           const auto values = element_outputs(model_, ws, Handle<E>{i});
@@ -196,6 +175,12 @@ class Recorder {
     std::string name;
     std::vector<std::string> fields;
   };
+
+  static std::vector<std::string> names_of(std::span<const Output> fields) {
+    std::vector<std::string> names;
+    for (const Output& field : fields) names.emplace_back(field.name);
+    return names;
+  }
 
   /// {element: {field: array over the outputs}} from rows of `width` numbers.
   py::dict by_field(const std::vector<FieldInfo>& elements, const std::vector<double>& data,

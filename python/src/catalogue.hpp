@@ -246,6 +246,8 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
       static_assert(is_well_formed(E::description), "a parameter of unknown kind or twice named");
       static_assert(!ListsOutputsItDoesNotCompute<E>,
                     "the description lists outputs that outputs(in) does not return");
+      static_assert(!ListsStateItDoesNotRecord<E>,
+                    "the description lists state fields that state_values does not return");
       if constexpr (IsUserForce<E>::value)
         out.emplace(E::description.type, &add_user_force);
       else

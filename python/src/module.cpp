@@ -6,6 +6,7 @@
 #include <Python.h>
 
 #include <cmath>
+#include <span>
 #include <sstream>
 #include <string>
 
@@ -268,7 +269,7 @@ py::object type_names() {
 
 /// The descriptions of the element types a model type can add, as plain Python values: a list
 /// of {type, category, summary, parameters: [{name, kind, default (JSON text or None), unit,
-/// doc}], outputs: [{name, unit, doc}]}.
+/// doc}], outputs and state_fields: [{name, unit, doc}]}.
 template <class M>
 py::list catalogue() {
   py::list out;
@@ -284,20 +285,24 @@ py::list catalogue() {
       entry["doc"] = p.doc;
       parameters.append(entry);
     }
-    py::list outputs;
-    for (const Output& o : d->outputs) {
-      py::dict entry;
-      entry["name"] = o.name;
-      entry["unit"] = o.unit;
-      entry["doc"] = o.doc;
-      outputs.append(entry);
-    }
+    const auto listed = [](std::span<const Output> fields) {
+      py::list out;
+      for (const Output& o : fields) {
+        py::dict entry;
+        entry["name"] = o.name;
+        entry["unit"] = o.unit;
+        entry["doc"] = o.doc;
+        out.append(entry);
+      }
+      return out;
+    };
     py::dict element;
     element["type"] = d->type;
     element["category"] = d->category;
     element["summary"] = d->summary;
     element["parameters"] = parameters;
-    element["outputs"] = outputs;
+    element["outputs"] = listed(d->outputs);
+    element["state_fields"] = listed(d->state_fields);
     out.append(element);
   }
   return out;

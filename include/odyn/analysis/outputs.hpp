@@ -1,7 +1,8 @@
 #pragma once
 // What results report beyond the state and the reactions: every element's own outputs
 // (core/outputs.hpp) and the motion of any point on a body, from a workspace at an output time
-// (its frames, velocities and accelerations as the analysis left them).
+// (its frames, velocities and accelerations as the analysis left them). Stateful elements' states
+// are recorded by their state_values (core/state_fields.hpp).
 
 #include <array>
 #include <string>
@@ -11,6 +12,7 @@
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/outputs.hpp"
+#include "odyn/core/state_fields.hpp"
 
 namespace odyn {
 

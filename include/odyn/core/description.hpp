@@ -26,7 +26,8 @@ struct Parameter {
   const char* doc;       // one line
 };
 
-/// One named output an element reports (core/outputs.hpp), as ADAMS's requests do.
+/// One named output an element reports (core/outputs.hpp), as ADAMS's requests do, or one
+/// field of a stateful element's recorded state (core/state_fields.hpp).
 struct Output {
   const char* name;  // as results, scene files and CSV columns call it
   const char* unit;  // SI unit; "" for none
@@ -40,6 +41,7 @@ struct ElementDescription {
   const char* summary;   // one line: what it does (and its number of equations)
   std::span<const Parameter> parameters;
   std::span<const Output> outputs = {};  // what outputs(in) returns, in order
+  std::span<const Output> state_fields = {};  // what state_values(state) returns, in order
 };
 
 /// A kind of parameter value, and how it reads in each space.
@@ -104,7 +106,7 @@ constexpr std::array<Parameter, N + M> join(const std::array<Parameter, N>& firs
 }
 
 /// True if every parameter of the description has a known kind and a unique name, and every
-/// output a unique name.
+/// output and state field a unique name.
 constexpr bool is_well_formed(const ElementDescription& description) {
   const auto same = [](const char* a, const char* b) {
     while (*a != '\0' && *a == *b) ++a, ++b;
@@ -115,9 +117,10 @@ constexpr bool is_well_formed(const ElementDescription& description) {
     for (std::size_t j = 0; j < i; ++j)
       if (same(description.parameters[i].name, description.parameters[j].name)) return false;
   }
-  for (std::size_t i = 0; i < description.outputs.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (same(description.outputs[i].name, description.outputs[j].name)) return false;
+  for (const auto& list : {description.outputs, description.state_fields})
+    for (std::size_t i = 0; i < list.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (same(list[i].name, list[j].name)) return false;
   return true;
 }
 

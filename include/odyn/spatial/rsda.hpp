@@ -36,11 +36,17 @@ class Rsda : public PairJoint {
       {"rate", "rad/s", "theta'"},
       {"torque", "N m", "the torque on b about the axis"},
   }};
+  static constexpr std::array<Output, 1> state_list{{
+      {"angle", "rad", "the unwrapped angle at the last accepted step"},
+  }};
   static constexpr ElementDescription description{
-      "rsda", "force",
+      "rsda",
+      "force",
       "Rotational spring-damper-actuator about a's axis: torque on b -(k (theta - free_angle) + c "
       "theta') + actuator(t, theta, theta').",
-      parameter_list, output_list};
+      parameter_list,
+      output_list,
+      state_list};
   template <class Reader>
   static Rsda from_parameters(Reader& r) {
     return parameters::from_frame_pair<Rsda, JointFrame>(
@@ -54,6 +60,7 @@ class Rsda : public PairJoint {
       throw ModelError(name_, "stiffness, damping and free angle must be finite");
   }
 
+  static std::array<double, 1> state_values(const State& state) { return {state.angle}; }
   State initial_state(const Input& in) const { return {wrapped_angle(in)}; }
   void advance(const Input& in, State& state) const { state.angle = angle(in, state); }
 
