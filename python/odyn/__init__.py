@@ -30,8 +30,8 @@ from ._schema import SceneError
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
 from .results import (AssemblyWarning, BodyHistory, Interrupted, PlanarBodyHistory,
-                      PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics, ToleranceWarning,
-                      assemble, integrators, simulate)
+                      PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics,
+                      ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
 
 #: Every element type that Model.add accepts (and scenes, except user_force).

@@ -20,9 +20,10 @@
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"},
                   {"name": "pin_vx", "point": "pin", "quantity": "velocity", "component": "x"},
-                  (+ "relative_to": a point, "axes": "global", a body or a point, "seen_from":
-                   a body or a point; see Result.relative), {"name": "spring_force", "element": "spring",
-                   "output": "tension"} (see odyn elements TYPE), ...],
+                  (+ "relative_to": a point, "axes": "global", a body or a point,
+                   "seen_from": a body or a point; see Result.relative),
+                  {"name": "spring_force", "element": "spring", "output": "tension"}
+                  (see odyn elements TYPE), ...],
       "figures": [{"file": "piston.png", "y": "z_piston", "title": "...", "ylabel": "..."}]
     }
 
@@ -300,8 +301,8 @@ def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
         values = getattr(r, spec["quantity"])
         return values if values.ndim == 1 else values[:, COMPONENTS[spec["component"]]]
     if "point" in spec:
-        motion = result.relative(spec["point"], spec.get("relative_to"), spec.get("axes", "global"),
-                                 spec.get("seen_from", "ground"))
+        motion = result.relative(spec["point"], spec.get("relative_to"),
+                                 spec.get("axes", "global"), spec.get("seen_from", "ground"))
         return getattr(motion, spec["quantity"])[:, COMPONENTS[spec["component"]]]
     if "element" in spec:
         return result.output(spec["element"], spec["output"])
