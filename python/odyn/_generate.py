@@ -198,7 +198,8 @@ def elements_markdown() -> str:
         "drivers and spring laws; `include/odyn/spatial/joint_primitives.hpp` is a short "
         "example). An element with outputs lists them (`outputs`, optional) and computes them "
         "in `outputs(in)` (`include/odyn/core/outputs.hpp`; `include/odyn/forces/tsda.hpp` is "
-        "an example).",
+        "an example); a stateful one lists the fields of its state that results record "
+        "(`state_fields`, with `state_values(state)`; `include/odyn/core/state_fields.hpp`).",
         "2. Register it: add the type to `odyn::spatial::DefaultModel` or "
         "`odyn::planar::DefaultModel` and to the matching model type of the Python bindings "
         "(`python/src/bindings.hpp`; a static_assert there fails until it holds every type of "
