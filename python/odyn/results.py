@@ -230,14 +230,14 @@ class Result:
         if body == 0:
             zero = np.zeros((n, dim))
             return PointHistory(np.tile(local, (n, 1)), zero, zero.copy())
-        arm = np.einsum("nij,j->ni", self._rotations(body), local)  # R s, global
+        rotations = self._rotations(body)
+        arm = np.einsum("nij,j->ni", rotations, local)  # R s, global
         if self.space == "planar":
             q, v, a = (x[:, 3 * (body - 1):3 * body] for x in (self.q, self.v, self.vdot))
             across = np.stack([-arm[:, 1], arm[:, 0]], -1)  # the arm turned a quarter
             omega, alpha = v[:, 2:3], a[:, 2:3]
             return PointHistory(q[:, :2] + arm, v[:, :2] + omega * across,
                                 a[:, :2] + alpha * across - omega ** 2 * arm)
-        rotations = self._rotations(body)
         q = self.q[:, 7 * (body - 1):7 * (body - 1) + 3]
         v = self.v[:, 6 * (body - 1):6 * body]
         a = self.vdot[:, 6 * (body - 1):6 * body]

@@ -66,7 +66,6 @@ def test_a_point_on_a_turning_rotor_follows_its_circle(space):
         np.testing.assert_allclose(rim.acceleration[:, 2], 0, atol=1e-7)
     # Relative to the hub, in the rotor's axes, the rim stands still: its position is constant
     # and its velocity difference is omega x (its offset), both in body axes.
-    local = m.point("rim")["at"]
     relative = r.relative("rim", "hub", axes="rotor")
     np.testing.assert_allclose(relative.position, relative.position[:1].repeat(len(r.t), 0),
                                atol=1e-9)
@@ -89,7 +88,6 @@ def test_a_point_on_a_turning_rotor_follows_its_circle(space):
     np.testing.assert_allclose(r.point("centre").position, body.position)
     np.testing.assert_allclose(r.point("centre").velocity, body.linear_velocity)
     np.testing.assert_allclose(r.point("centre").acceleration, body.linear_acceleration)
-    assert local == pytest.approx([0.3, -0.05, 0.1][:dim])
 
 
 def test_motion_seen_from_a_tumbling_body():
