@@ -1,7 +1,8 @@
 #pragma once
 // Dynamic analysis: assemble, then integrate with the chosen integrator (fixed steps, or steps
 // under error control with outputs interpolated where the integrator can), end steps exactly on
-// the switches of force laws, and hand the workspace to an observer at t0 and at each output.
+// the switches of force laws, locate the events of watched functions (analysis/watches.hpp),
+// and hand the workspace to an observer at t0 and at each output.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -17,6 +18,8 @@
 
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/analysis/watches.hpp"
+#include "odyn/analysis/zero_crossing.hpp"
 #include "odyn/integrators/adams.hpp"
 #include "odyn/integrators/bdf.hpp"
 #include "odyn/integrators/dop853.hpp"
@@ -91,6 +94,10 @@ struct RunSummary {
   /// The coordinates the run stepped ("absolute" or "joint") and, for coordinates "auto", why.
   std::string coordinates;
   std::string coordinates_choice;
+  /// The located crossings of the run's watches, in time order; `ended_by` names the terminal
+  /// watch whose crossing ended the run (the last output is then at its time), else "".
+  std::vector<Event> events;
+  std::string ended_by;
 };
 
 /// An assembled initial state kept to start runs from, so that the setup runs once for several
@@ -146,13 +153,7 @@ void end_step_on_switch(
   // than nothing: an index-3 step of a few femtoseconds turns the rounding in Phi into large
   // velocity errors (the switch is then located to within min_trial).
   const double min_trial = std::max(event_time_tolerance, 1e-6 * h);
-  double lo = 0.0, hi = h, g_lo = g_start, g_hi = g_end;
-  int stale_side = 0;
-  while (hi - lo > event_time_tolerance) {
-    double trial = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-    if (!(trial > lo && trial < hi)) trial = 0.5 * (lo + hi);
-    trial = std::max(trial, min_trial);
-    if (trial >= hi) break;
+  const auto g = [&](double trial) {
     if constexpr (DenseOutputIntegrator<Integrator>) {
       if (from_dense_output)
         integrator.interpolate_frames(integrator.time() + trial);
@@ -161,17 +162,10 @@ void end_step_on_switch(
     } else if (!integrator.attempt(trial)) {
       integrator.fail();
     }
-    const double g = event_function(model, ws);
-    if (g >= 0.0) {
-      hi = trial, g_hi = g;
-      if (stale_side == 1) g_lo *= 0.5;  // Illinois: keep the other end moving
-      stale_side = 1;
-    } else {
-      lo = trial, g_lo = g;
-      if (stale_side == -1) g_hi *= 0.5;
-      stale_side = -1;
-    }
-  }
+    return event_function(model, ws);
+  };
+  const double hi =
+      narrow_crossing({0.0, h, g_start, g_end}, event_time_tolerance, min_trial, g).hi;
   // End just past the switch, so that the element moves on to its next law. Solved again, the
   // step may land a hair before it (Newton stops within its tolerance, on another path): then
   // end a little later, or the next step would meet the same switch.
@@ -185,6 +179,48 @@ void end_step_on_switch(
   integrator.commit();
   integrator.restart();
   integrator.count_event();
+}
+
+/// Locates the crossings of the watches in the step the integrator has just attempted, on its
+/// dense output (`dense`) or by shorter attempts, and leaves its trial state in the workspace:
+/// cut to end on the first terminal crossing if there is one (its time returned).
+template <class Model, class Integrator>
+std::optional<double> watch_trial(Workspace<Model>& ws, Integrator& integrator,
+                                  Watcher<Model>* watcher, bool dense) {
+  if (watcher == nullptr || watcher->empty()) return std::nullopt;
+  const double t_n = integrator.time(), h = ws.t - t_n;
+  bool moved = false;
+  const auto state_at = [&](double dt) {
+    moved = true;
+    if constexpr (DenseOutputIntegrator<Integrator>) {
+      if (dense) return integrator.interpolate_frames(t_n + dt);
+    }
+    if (!integrator.attempt(dt)) integrator.fail();
+  };
+  // Attempts a few femtoseconds long would turn the rounding in Phi into velocity errors (see
+  // end_step_on_switch); the interpolant has no such limit.
+  const std::optional<double> terminal = watcher->locate(ws, t_n, state_at, dense ? 0.0 : 1e-6 * h);
+  if (terminal) {
+    if (!integrator.attempt(*terminal - t_n)) integrator.fail();
+  } else if (moved) {
+    bool restored = false;
+    if constexpr (DenseOutputIntegrator<Integrator>) {
+      if (dense) integrator.restore_trial(), restored = true;
+    }
+    if (!restored && !integrator.attempt(h)) integrator.fail();
+  }
+  return terminal;
+}
+
+/// After the commit, at `t`, of a step that watch_trial saw: its events recorded, and the run
+/// ended if one was terminal.
+template <class Model>
+void watched_step_committed(Watcher<Model>* watcher, bool terminal, double t) {
+  if (watcher == nullptr || watcher->empty()) return;
+  if (terminal)
+    watcher->end_at(t);
+  else
+    watcher->committed();
 }
 
 }  // namespace detail
@@ -204,10 +240,13 @@ struct StepCut {
 /// steps (`cut` keeps that state across calls; the run stops when the smallest step fails too). An
 /// adaptive integrator takes the steps its error control proposes (never longer than `max_step`),
 /// and a rejected step is tried again shorter. A step in which an element's event function crosses
-/// zero is cut back to end on the switch, then the integrator restarts.
+/// zero is cut back to end on the switch, then the integrator restarts. With `watcher`, the
+/// watches' crossings in each step are located; a terminal one ends the advance on it (see
+/// Watcher::ended).
 template <class Model, StepIntegrator Integrator>
 void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator, double t_target,
-                double fixed_step, double event_time_tolerance = 1e-12, StepCut* cut = nullptr) {
+                double fixed_step, double event_time_tolerance = 1e-12, StepCut* cut = nullptr,
+                detail::Watcher<Model>* watcher = nullptr) {
   constexpr bool can_adapt = AdaptiveIntegrator<Integrator>;
   const bool adaptive = can_adapt && integrator.adaptive();
   StepCut local_cut;
@@ -254,17 +293,27 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
     if constexpr (has_events<Model>()) {
       const double g_end = event_function(model, ws);
       if (g_end >= 0.0 && g_start < 0.0) {
-        detail::end_step_on_switch(model, ws, integrator, h, g_start, g_end, event_time_tolerance);
+        std::optional<double> terminal;
+        detail::end_step_on_switch(
+            model, ws, integrator, h, g_start, g_end, event_time_tolerance,
+            [&] { terminal = detail::watch_trial(ws, integrator, watcher, false); });
+        detail::watched_step_committed(watcher, terminal.has_value(), ws.t);
+        if (terminal) return;
         continue;
       }
     }
+    const std::optional<double> terminal = detail::watch_trial(ws, integrator, watcher, false);
     if constexpr (can_adapt) {
       if (adaptive) {
         integrator.accept();
+        detail::watched_step_committed(watcher, terminal.has_value(), ws.t);
+        if (terminal) return;
         continue;
       }
     }
     integrator.commit();
+    detail::watched_step_committed(watcher, terminal.has_value(), ws.t);
+    if (terminal) return;
     if (step_cut.halvings > 0 && ++step_cut.good_steps >= step_cut.needed) {
       --step_cut.halvings;
       step_cut.good_steps = 0;
@@ -290,11 +339,14 @@ struct OutputGrid {
 /// are interpolated (so they do not cut the steps), and `record()` sees each one with the
 /// stateful elements advanced to it. Ends exactly at the last output time; events as in
 /// advance_to. `stop()`, asked after every accepted step, ends the run there early (the
-/// workspace then holds the committed state): false if it did.
+/// workspace then holds the committed state): false if it did. With `watcher`, the watches'
+/// crossings are located on the dense output; a terminal one ends the run on it, with one more
+/// output there (the grid is then done).
 template <class Model, DenseOutputIntegrator Integrator, class Record, class Stop>
 bool advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integrator& integrator,
                                OutputGrid& grid, Record&& record, Stop&& stop,
-                               double event_time_tolerance = 1e-12) {
+                               double event_time_tolerance = 1e-12,
+                               detail::Watcher<Model>* watcher = nullptr) {
   const double t_end = grid.time(grid.count);
   const double time_tolerance = 1e-12 * std::max(1.0, std::abs(t_end));
   auto saved_states = ws.states;  // sized once: the copies below allocate nothing
@@ -319,6 +371,12 @@ bool advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
     }
     if (interpolated) integrator.restore_trial();
   };
+  // The run ends on a terminal crossing: an output there too, unless one of the grid's was.
+  const auto end_on_event = [&] {
+    if (k == 1 || std::abs(grid.time(k - 1) - ws.t) > time_tolerance) record();
+    k = grid.count + 1;
+    return true;
+  };
   while (k <= grid.count) {
     const double remaining = t_end - integrator.time();
     double h = std::min(integrator.proposed_step(), remaining);
@@ -332,13 +390,24 @@ bool advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
     if constexpr (has_events<Model>()) {
       const double g_end = event_function(model, ws);
       if (g_end >= 0.0 && g_start < 0.0) {
-        detail::end_step_on_switch(model, ws, integrator, h, g_start, g_end, event_time_tolerance,
-                                   emit, true);
+        std::optional<double> terminal;
+        detail::end_step_on_switch(
+            model, ws, integrator, h, g_start, g_end, event_time_tolerance,
+            [&] {
+              terminal = detail::watch_trial(ws, integrator, watcher, true);
+              emit();
+            },
+            true);
+        detail::watched_step_committed(watcher, terminal.has_value(), ws.t);
+        if (terminal) return end_on_event();
         continue;
       }
     }
+    const std::optional<double> terminal = detail::watch_trial(ws, integrator, watcher, true);
     emit();
     integrator.accept();
+    detail::watched_step_committed(watcher, terminal.has_value(), ws.t);
+    if (terminal) return end_on_event();
     if (k <= grid.count && stop()) return false;
   }
   return true;
@@ -475,18 +544,24 @@ struct OutputRecorder {
 };
 
 /// Runs an integrator from the workspace's state through the grid's remaining outputs, or, if
-/// it interpolates its outputs, until stop() after an accepted step: false if it stopped.
+/// it interpolates its outputs, until stop() after an accepted step: false if it stopped. A
+/// terminal watch's crossing ends the run there, with an output at its time.
 template <class Model, class Integrator, class Recorder, class Stop>
 bool run_integrator(const Model& model, Workspace<Model>& ws, Integrator& integrator,
-                    const DynamicsSettings& s, OutputGrid& grid, Recorder& recorder, Stop&& stop) {
+                    const DynamicsSettings& s, OutputGrid& grid, Recorder& recorder, Stop&& stop,
+                    Watcher<Model>& watcher) {
   const auto record = [&] { recorder(integrator); };
   if constexpr (DenseOutputIntegrator<Integrator>)
     if (integrator.adaptive())
-      return advance_with_dense_output(model, ws, integrator, grid, record, stop);
+      return advance_with_dense_output(model, ws, integrator, grid, record, stop, 1e-12, &watcher);
   StepCut cut;
   for (; !grid.done(); ++grid.next) {
-    advance_to(model, ws, integrator, grid.time(grid.next), s.step, 1e-12, &cut);
+    advance_to(model, ws, integrator, grid.time(grid.next), s.step, 1e-12, &cut, &watcher);
     record();
+    if (watcher.ended()) {
+      grid.next = grid.count + 1;
+      break;
+    }
   }
   return true;
 }
@@ -510,10 +585,13 @@ inline void add_statistics(IntegratorStatistics& total, const IntegratorStatisti
 /// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
 /// instantiated), from the workspace's state (assembled first, or taken from `start`, see
 /// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
-/// and element blocks up to date.
+/// and element blocks up to date, and at the end of a run that a terminal watch ended. The
+/// crossings of `watches` are located and returned in the summary's events.
 template <template <class> class IntegratorType, class Model, class Observer>
 RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
+                         Observer&& observe,
+                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                         WatchList<Model> watches = {}) {
   using Integrator = IntegratorType<Model>;
   static_assert(StepIntegrator<Integrator>);
   const auto started = std::chrono::steady_clock::now();
@@ -526,9 +604,13 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
   recorder(integrator);
+  detail::Watcher<Model> watcher(watches);
+  watcher.start(ws);
   OutputGrid grid = detail::output_grid(s, ws.t);
-  detail::run_integrator(model, ws, integrator, s, grid, recorder, [] { return false; });
+  detail::run_integrator(model, ws, integrator, s, grid, recorder, [] { return false; }, watcher);
   summary.statistics = integrator.statistics();
+  summary.events = watcher.events();
+  summary.ended_by = watcher.ended_by();
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
@@ -548,7 +630,9 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
 template <template <class> class Explicit, template <class> class Stiff,
           template <class> class Robust, class Model, class Observer>
 RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe, AssembledStart<Model>* start = nullptr) {
+                         Observer&& observe,
+                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                         WatchList<Model> watches = {}) {
   const auto started = std::chrono::steady_clock::now();
   RunSummary summary = detail::start_run(model, ws, s, start);
   const Workspace<Model> assembled = ws;  // for the robust run, if it comes to that
@@ -561,15 +645,17 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
   recorder(*explicit_method);
+  detail::Watcher<Model> watcher(watches);
+  watcher.start(ws);
   OutputGrid grid = detail::output_grid(s, ws.t);
   summary.integrator = "dop853";
   summary.integrator_choice = "auto: dop853 throughout (not stiff, no failure)";
   std::string failure;
   double failed_at = 0.0;
   try {
-    const bool finished =
-        detail::run_integrator(model, ws, *explicit_method, s, grid, recorder,
-                               [&] { return explicit_method->stiffness_detected(); });
+    const bool finished = detail::run_integrator(
+        model, ws, *explicit_method, s, grid, recorder,
+        [&] { return explicit_method->stiffness_detected(); }, watcher);
     if (!finished) {
       const double stiff_from = explicit_method->time();
       summary.integrator = "dop853, then bdf from t = " + to_text(stiff_from) + " s";
@@ -587,11 +673,14 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
       bool paid_off = true;
       try {
         stiff.emplace(model, ws, detail::integrator_settings<BdfSettings>(s), control);
-        paid_off = detail::run_integrator(model, ws, *stiff, s, grid, recorder, [&] {
-          const long steps = stiff->statistics().steps;
-          return steps == auto_trial_steps &&
-                 (stiff->time() - stiff_from) / static_cast<double>(steps) < explicit_mean_step;
-        });
+        paid_off = detail::run_integrator(
+            model, ws, *stiff, s, grid, recorder,
+            [&] {
+              const long steps = stiff->statistics().steps;
+              return steps == auto_trial_steps &&
+                     (stiff->time() - stiff_from) / static_cast<double>(steps) < explicit_mean_step;
+            },
+            watcher);
       } catch (const SolverError& error) {
         failure = error.message();
         failed_at = error.time();
@@ -606,8 +695,8 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
                                      "again";
         explicit_method.emplace(model, ws, detail::integrator_settings<DormandPrinceSettings>(s),
                                 control);
-        detail::run_integrator(model, ws, *explicit_method, s, grid, recorder,
-                               [] { return false; });
+        detail::run_integrator(
+            model, ws, *explicit_method, s, grid, recorder, [] { return false; }, watcher);
       }
     }
   } catch (const SolverError& error) {
@@ -632,19 +721,25 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
     ws = assembled;
     Robust<Model> robust(
         model, ws, detail::integrator_settings<GeneralizedAlphaSettings>(robust_settings), control);
+    // Its events count from the last output handed over, as its outputs do.
+    watcher.rewind(grid.time(grid.next - 1));
+    watcher.start(ws);
     try {
       StepCut cut;
       for (long k = 1; k < grid.next; ++k)
-        advance_to(model, ws, robust, grid.time(k), s.step, 1e-12, &cut);
+        advance_to(model, ws, robust, grid.time(k), s.step, 1e-12, &cut, &watcher);
       for (; !grid.done(); ++grid.next) {
-        advance_to(model, ws, robust, grid.time(grid.next), s.step, 1e-12, &cut);
+        advance_to(model, ws, robust, grid.time(grid.next), s.step, 1e-12, &cut, &watcher);
         recorder(robust);
+        if (watcher.ended()) break;
       }
     } catch (const SolverError& error) {
       throw SolverError(error.time(), error.message() + " (" + summary.integrator_choice + ")");
     }
     detail::add_statistics(summary.statistics, robust.statistics());
   }
+  summary.events = watcher.events();
+  summary.ended_by = watcher.ended_by();
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
@@ -653,20 +748,23 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
 /// simulate()'s dispatch by the integrator's name, in the coordinates the settings name.
 template <class Model, class Observer>
 RunSummary simulate_by_name(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                            Observer&& observe, AssembledStart<Model>* start = nullptr) {
+                            Observer&& observe,
+                            AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                            WatchList<Model> watches = {}) {
   if (s.coordinates == "joint") {
     if (s.integrator == "auto")
-      return simulate_auto<JointDormandPrince853, JointBdf, JointGeneralizedAlpha>(model, ws, s,
-                                                                                   observe, start);
+      return simulate_auto<JointDormandPrince853, JointBdf, JointGeneralizedAlpha>(
+          model, ws, s, observe, start, watches);
     if (s.integrator == "dopri5")
-      return simulate_with<JointDormandPrince>(model, ws, s, observe, start);
+      return simulate_with<JointDormandPrince>(model, ws, s, observe, start, watches);
     if (s.integrator == "dop853")
-      return simulate_with<JointDormandPrince853>(model, ws, s, observe, start);
+      return simulate_with<JointDormandPrince853>(model, ws, s, observe, start, watches);
     if (s.integrator == "adams")
-      return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start);
+      return simulate_with<JointAdamsBashforth>(model, ws, s, observe, start, watches);
     if (s.integrator == "generalized-alpha" || s.integrator == "hht")
-      return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start);
-    if (s.integrator == "bdf") return simulate_with<JointBdf>(model, ws, s, observe, start);
+      return simulate_with<JointGeneralizedAlpha>(model, ws, s, observe, start, watches);
+    if (s.integrator == "bdf")
+      return simulate_with<JointBdf>(model, ws, s, observe, start, watches);
     throw ModelError("dynamics",
                      "joint coordinates run with auto, generalized-alpha, hht, bdf, dopri5, "
                      "dop853 or adams, not '" +
@@ -677,14 +775,17 @@ RunSummary simulate_by_name(const Model& model, Workspace<Model>& ws, const Dyna
                                      "'; choose 'auto', 'absolute' or 'joint'");
   }
   if (s.integrator == "auto")
-    return simulate_auto<DormandPrince853, Bdf, GeneralizedAlpha>(model, ws, s, observe, start);
+    return simulate_auto<DormandPrince853, Bdf, GeneralizedAlpha>(model, ws, s, observe, start,
+                                                                  watches);
   if (s.integrator == "generalized-alpha" || s.integrator == "hht")
-    return simulate_with<GeneralizedAlpha>(model, ws, s, observe, start);
-  if (s.integrator == "dopri5") return simulate_with<DormandPrince>(model, ws, s, observe, start);
+    return simulate_with<GeneralizedAlpha>(model, ws, s, observe, start, watches);
+  if (s.integrator == "dopri5")
+    return simulate_with<DormandPrince>(model, ws, s, observe, start, watches);
   if (s.integrator == "dop853")
-    return simulate_with<DormandPrince853>(model, ws, s, observe, start);
-  if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe, start);
-  if (s.integrator == "adams") return simulate_with<AdamsBashforth>(model, ws, s, observe, start);
+    return simulate_with<DormandPrince853>(model, ws, s, observe, start, watches);
+  if (s.integrator == "bdf") return simulate_with<Bdf>(model, ws, s, observe, start, watches);
+  if (s.integrator == "adams")
+    return simulate_with<AdamsBashforth>(model, ws, s, observe, start, watches);
   std::string known;
   for (const auto& [name, what] : integrator_names()) known += (known.empty() ? "" : ", ") + name;
   throw ModelError("dynamics", "unknown integrator '" + s.integrator + "'; choose one of " + known);
@@ -749,8 +850,9 @@ CoordinatesChoice choose_coordinates(const Model& model, const DynamicsSettings&
 template <class Model, class Observer>
 RunSummary simulate_in_coordinates(const Model& model, Workspace<Model>& ws,
                                    const DynamicsSettings& s, Observer&& observe,
-                                   AssembledStart<Model>* start = nullptr) {
-  RunSummary summary = simulate_by_name(model, ws, s, observe, start);
+                                   AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                                   WatchList<Model> watches = {}) {
+  RunSummary summary = simulate_by_name(model, ws, s, observe, start, watches);
   summary.coordinates = s.coordinates;
   return summary;
 }
@@ -758,17 +860,21 @@ RunSummary simulate_in_coordinates(const Model& model, Workspace<Model>& ws,
 /// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()),
 /// in the settings' coordinates; for "auto", those of choose_coordinates, after the assembly
 /// (which finds redundant equations), the run starting from its state. With `start`, runs after
-/// the first start from its assembled state (see AssembledStart).
+/// the first start from its assembled state (see AssembledStart). The crossings of `watches`
+/// (events) are located in every step and returned in the summary; a terminal one ends the run.
 template <class Model, class Observer>
 RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                    Observer&& observe, AssembledStart<Model>* start = nullptr) {
-  if (s.coordinates != "auto") return simulate_in_coordinates(model, ws, s, observe, start);
+                    Observer&& observe,
+                    AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                    WatchList<Model> watches = {}) {
+  if (s.coordinates != "auto")
+    return simulate_in_coordinates(model, ws, s, observe, start, watches);
   const auto& known = integrator_names();
   if (std::none_of(known.begin(), known.end(),
                    [&](const auto& entry) { return entry.first == s.integrator; })) {
     DynamicsSettings named = s;  // refused by name, before any assembly
     named.coordinates = "absolute";
-    return simulate_in_coordinates(model, ws, named, observe, start);
+    return simulate_in_coordinates(model, ws, named, observe, start, watches);
   }
   const auto started = std::chrono::steady_clock::now();
   AssembledStart<Model> local;
@@ -779,7 +885,7 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   const CoordinatesChoice choice = choose_coordinates(model, s, assembled.redundant_equations);
   DynamicsSettings chosen = s;
   chosen.coordinates = choice.coordinates;
-  RunSummary summary = simulate_in_coordinates(model, ws, chosen, observe, kept);
+  RunSummary summary = simulate_in_coordinates(model, ws, chosen, observe, kept, watches);
   // The run started from the state assembled above: count that assembly as this run's.
   summary.assembly_reused = assembled.assembly_reused;
   summary.setup_seconds += assembly_seconds;

@@ -29,7 +29,7 @@ from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
-from .results import (AssemblyWarning, BodyHistory, Interrupted, PlanarBodyHistory,
+from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBodyHistory,
                       PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics,
                       ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
@@ -43,7 +43,8 @@ planar_element_types = tuple(
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Interrupted",
+    "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Event",
+    "Interrupted",
     "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
     "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
     "ToleranceWarning", "assemble", "constant_velocity", "element_types", "frame", "harmonic",

@@ -127,7 +127,8 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
         lines.append(f"  {s['coordinates_choice']}")
     if s:
         steps = s["steps"]
-        lines.append(f"  steps {steps} (events {s['events']}, rejected {s['rejected_steps']}), "
+        lines.append(f"  steps {steps} (law switches {s['events']}, rejected "
+                     f"{s['rejected_steps']}), "
                      f"Newton iterations {s['newton_iterations']} "
                      f"({s['newton_iterations'] / max(steps, 1):.2f} per step), "
                      f"Jacobians {s['jacobian_evaluations']}, "
@@ -143,6 +144,13 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
     else:
         lines.append(f"  stopped at t = {result.t[-1] if len(result) else 0.0:g} s "
                      f"after {wall:.3f} s")
+    if result.events:
+        lines.append(f"  events ({len(result.events)}): " + ", ".join(
+            f"{e.name} {e.direction} at {e.time:.9g} s" for e in result.events[:8])
+            + (", ..." if len(result.events) > 8 else ""))
+    if result.ended_by:
+        lines.append(f"  ended by the terminal event '{result.ended_by}' at t = "
+                     f"{result.events[-1].time:.9g} s")
     if result.redundant_equations:
         lines.append("  redundant constraint equations (minimum-norm reactions): " + ", ".join(
             f"{e['joint']} (equation {e['equation']})" for e in result.redundant_equations))
@@ -225,6 +233,8 @@ def _check(args: argparse.Namespace) -> int:
     print(f"  analysis: {describe_integrator(a)}, t_end {a['t_end']:g} s, output every "
           f"{a['output_interval']:g} s")
     print(f"  outputs: t, {', '.join(o['name'] for o in scene.outputs)}")
+    if m.event_names:
+        print(f"  events: {', '.join(m.event_names)}")
     return 0
 
 

@@ -29,6 +29,8 @@ FrameFunction = Callable[[float, Any], Sequence[float]]
 ComponentMatrix = Union[Sequence[float], Sequence[Sequence[float]]]
 #: A bushing's law: f(t, x, x') -> a wrench, x and x' NumPy arrays of 6 numbers (3 in the plane).
 WrenchLaw = Callable[[float, Any, Any], Sequence[float]]
+#: Which crossings of its value an event reports (see BaseModel.add_event).
+EVENT_DIRECTIONS = ("rising", "falling", "either")
 
 
 def frame(point: Optional[Vector] = None, axis: Optional[Vector] = None,
@@ -96,6 +98,8 @@ class BaseModel:
         self._checked: Dict[str, Tuple[str, Dict[str, Any]]] = {}
         # name -> {"name", "body", "at"}: the named points (markers), in the order added.
         self._points: Dict[str, Dict[str, Any]] = {}
+        # name -> the event as added and checked (see add_event), in the order added.
+        self._events: Dict[str, Dict[str, Any]] = {}
 
     def _add_body(self, params: Mapping[str, Any], where: str) -> str:
         body = _schema.check_body(params, where,
@@ -179,6 +183,127 @@ class BaseModel:
     def _point_table(self) -> Dict[str, Tuple[int, List[float]]]:
         """name -> (body index, 0 for the ground; point in body coordinates), for results."""
         return {n: (self._body_index[p["body"]], p["at"]) for n, p in self._points.items()}
+
+    # --- events ----------------------------------------------------------------------------
+    def add_event(self, name: str, *, output: Optional[Sequence[str]] = None,
+                  point: Optional[Sequence[str]] = None,
+                  function: Optional[Callable[..., float]] = None,
+                  bodies: Sequence[str] = (), value: float = 0.0, direction: str = "either",
+                  terminal: bool = False) -> str:
+        """Adds an event (ADAMS's sensor): the times at which a quantity crosses `value`,
+        located within each step to the integrator's accuracy and listed in `Result.events`.
+        A terminal event ends the run at its first crossing (the last output row is there).
+        Returns its name. The quantity is one of:
+
+        output: (element, output), one of an element's outputs (`odyn elements TYPE`);
+        point: (point, "position" or "velocity", "x", "y" or "z"), a named point's, global;
+        function: function(t, body_0[, body_1]) -> float, of the `bodies` named (zero to two;
+        their views as a user force gets them). It may not keep the views between calls.
+
+        direction: "rising" (from below `value` to above it), "falling" or "either". Scene
+        files list events under "events" (all but functions)."""
+        given = {"name": name, "value": value, "direction": direction, "terminal": terminal}
+        for key, x in (("output", output), ("point", point), ("function", function)):
+            if x is not None:
+                given[key] = x
+        if function is not None or bodies:
+            given["bodies"] = bodies
+        return self._add_event(given, f"event '{name}'")
+
+    def _add_event(self, params: Mapping[str, Any], where: str) -> str:
+        d = _schema.check_keys(params, where, ("name", "output", "point", "function", "bodies",
+                                               "value", "direction", "terminal"), ("name",))
+        name = _schema.check_name(d["name"], f"{where}.name")
+        if name in self._events:
+            _schema.fail(f"{where}.name", f"there is already an event '{name}'")
+        kinds = [k for k in ("output", "point", "function") if k in d]
+        if len(kinds) != 1:
+            _schema.fail(where, "give one quantity to watch: output (element, output), point "
+                         "(point, quantity, component) or function, got "
+                         + (", ".join(kinds) or "none"))
+        event: Dict[str, Any] = {"name": name}
+        if "output" in d:
+            event["output"] = self._event_output(d["output"], f"{where}.output")
+        elif "point" in d:
+            event["point"] = self._event_point(d["point"], f"{where}.point")
+        else:
+            event["function"] = _schema.check_callable(d["function"], f"{where}.function")
+        if "bodies" in d:
+            if "function" not in d:
+                _schema.fail(f"{where}.bodies", "only a function event names bodies")
+            bodies = d["bodies"]
+            if not isinstance(bodies, (list, tuple)) or len(bodies) > 2:
+                _schema.fail(f"{where}.bodies", "expected a list of up to two body names, got "
+                             f"{bodies!r}")
+            event["bodies"] = [_schema._body(b, f"{where}.bodies[{i}]", self._body_index)
+                               for i, b in enumerate(bodies)]
+        elif "function" in d:
+            event["bodies"] = []
+        event["value"] = _schema.check_number(d.get("value", 0.0), f"{where}.value")
+        event["direction"] = _schema.check_choice(d.get("direction", "either"),
+                                                  f"{where}.direction", EVENT_DIRECTIONS)
+        event["terminal"] = _schema.check_flag(d.get("terminal", False), f"{where}.terminal")
+        self._events[name] = event
+        return name
+
+    def _event_output(self, x: Any, where: str) -> List[str]:
+        if not isinstance(x, (list, tuple)) or len(x) != 2:
+            _schema.fail(where, f"expected (element, output), got {x!r}")
+        element, output = x
+        if element not in self._elements:
+            _schema.fail(where, f"no element named {element!r}")
+        kind = self._elements[element][0]
+        outputs = [o["name"] for o in
+                   _schema.DESCRIPTIONS[self.space].get(kind, {}).get("outputs", [])]
+        if not outputs:
+            _schema.fail(where, f"'{element}' ({kind}) reports no outputs")
+        return [element, _schema.check_choice(output, f"{where}[1]", outputs)]
+
+    def _event_point(self, x: Any, where: str) -> List[str]:
+        if not isinstance(x, (list, tuple)) or len(x) != 3:
+            _schema.fail(where, f"expected (point, quantity, component), got {x!r}")
+        point, quantity, component = x
+        if point not in self._points:
+            _schema.fail(where, f"no point named {point!r}; points: "
+                         + (", ".join(self._points) or "none (add them with add_point)"))
+        if quantity == "acceleration":
+            _schema.fail(f"{where}[1]", "an event watches a point's position or velocity "
+                         "(accelerations are not kept current while a crossing is located); "
+                         "watch a force's output instead")
+        _schema.check_choice(quantity, f"{where}[1]", ("position", "velocity"))
+        axes = ("x", "y") if self.space == "planar" else ("x", "y", "z")
+        _schema.check_choice(component, f"{where}[2]", axes)
+        return [point, quantity, component]
+
+    @property
+    def event_names(self) -> List[str]:
+        return list(self._events)
+
+    def event(self, name: str) -> Dict[str, Any]:
+        """The event as added: {"name", one of "output", "point" or "function" (with
+        "bodies"), "value", "direction", "terminal"}."""
+        if name not in self._events:
+            raise SceneError(f"{name}: no event of that name in the model"
+                             + (f"; events: {', '.join(self._events)}" if self._events else ""))
+        return dict(self._events[name])
+
+    def _event_table(self) -> List[Dict[str, Any]]:
+        """The events as the run takes them: points and bodies by index."""
+        table = []
+        for e in self._events.values():
+            row = {k: e[k] for k in ("name", "value", "direction", "terminal")}
+            if "output" in e:
+                row.update(kind="output", element=e["output"][0], output=e["output"][1])
+            elif "point" in e:
+                point, quantity, component = e["point"]
+                body, at = self._point_table()[point]
+                row.update(kind="point", body=body, at=at, quantity=quantity,
+                           component="xyz".index(component))
+            else:
+                row.update(kind="function", function=e["function"],
+                           bodies=[self._body_index[b] for b in e["bodies"]])
+            table.append(row)
+        return table
 
     # --- what is in it ----------------------------------------------------------------------
     @property

@@ -71,6 +71,14 @@ class Reaction(NamedTuple):
     torque: np.ndarray  # (n, 3), about the joint point; planar (n,)
 
 
+class Event(NamedTuple):
+    """A located crossing of an event's value (see BaseModel.add_event)."""
+    name: str
+    time: float       # s
+    direction: str    # "rising" or "falling"
+    terminal: bool    # it ended the run
+
+
 class Statistics(NamedTuple):
     """What a dynamic analysis counted (the C++ IntegratorStatistics and RunSummary)."""
     steps: int                  # accepted steps
@@ -123,6 +131,8 @@ class Result:
     phid_norm (|Phi_q v + Phi_t|).
     By name: body(name), point(name), relative(point, to, axes), reaction(joint, side, axes),
     multipliers(joint), output(element, name), state(element).
+    events: the model's events in time order (Event: name, time, direction, terminal);
+    event_times(name); ended_by: the terminal event that ended the run, or None.
     statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
     early); summary: the same as a dict, with the assembly report.
     """
@@ -149,6 +159,8 @@ class Result:
         self.interrupted = interrupted
         self._bodies: List[str] = list(data["bodies"])
         self._points: Dict[str, Tuple[int, List[float]]] = dict(data.get("points", {}))
+        self.events: List[Event] = [Event(**e) for e in data.get("events", [])]
+        self.ended_by: Optional[str] = data.get("ended_by")
 
     def __len__(self) -> int:
         return len(self.t)
@@ -361,7 +373,8 @@ class Result:
         """Every array in one .npz file: t, q, v, vdot, lambda, energies, residuals,
         reaction/<joint> (n, side a/b, global/joint axes, force xyz + torque xyz),
         state/<element>/<field>, output/<element>/<name>, point/<point>/<position, velocity or
-        acceleration> and bodies (their names, in the order of q and v)."""
+        acceleration>, event/<name> (its times) and bodies (their names, in the order of q
+        and v)."""
         arrays = {key: self._data[key] for key in (
             "t", "q", "v", "vdot", "lambda", "kinetic_energy", "potential_energy", "phi_norm",
             "phid_norm")}
@@ -378,7 +391,13 @@ class Result:
         for name in self._points:
             for field, values in self.point(name)._asdict().items():
                 arrays[f"point/{name}/{field}"] = values
+        for name in dict.fromkeys(e.name for e in self.events):
+            arrays[f"event/{name}"] = self.event_times(name)
         np.savez(path, **arrays)  # type: ignore[arg-type]
+
+    def event_times(self, name: str) -> np.ndarray:
+        """The times of the event's crossings (s), in order (empty if it never crossed)."""
+        return np.array([e.time for e in self.events if e.name == name], dtype=float)
 
     def energy_drift(self) -> float:
         """Largest |E(t) - E(0)| of kinetic plus potential energy (work of dampers and
@@ -546,6 +565,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          coordinates=check_choice(coordinates, "coordinates", COORDINATES),
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
+    settings["events"] = model._event_table()
     data = _core.simulate(model._core, settings, progress)
     data["points"] = model._point_table()
     error = data.pop("error")

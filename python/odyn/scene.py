@@ -11,6 +11,10 @@
                    "motion": {"type": "constant_velocity", "rate": 10.0}}],
       "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
       "points":  [{"name": "pin", "body": "crank", "at": [0, 0.05, 0]}],   (markers)
+      "events":  [{"name": "top", "point": ["pin", "position", "z"], "value": 0.05,
+                   "direction": "rising", "terminal": false},
+                  {"name": "stretched", "output": ["spring", "length"], "value": 0.3}],
+                 (see Model.add_event; Result.events lists their crossings)
       "analysis": {"t_end": 1.0, "output_interval": 1e-3},   (+ integrator, rho_inf, step,
                    rtol, atol, max_step, adaptive, newton_rtol, newton_atol,
                    constraint_tolerance, max_iterations, projection_tolerance, order,
@@ -37,7 +41,7 @@ from __future__ import annotations
 import csv
 import json
 import os
-from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -54,6 +58,7 @@ SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _sch
                           "forces": _SCENE_FORCES} for space in SPACES}
 SECTIONS = SPACE_SECTIONS["spatial"]
 TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "points",
+            "events",
             "analysis", "outputs", "figures")
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 # Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
@@ -122,6 +127,12 @@ class Scene:
             out[section] = entries
         if self.model._points:
             out["points"] = [dict(p) for p in self.model._points.values()]
+        if self.model._events:
+            for name, e in self.model._events.items():
+                if "function" in e:
+                    fail(f"events: '{name}'", "a function event is a Python function and "
+                         "cannot be saved in a scene file")
+            out["events"] = [dict(e) for e in self.model._events.values()]
         out["analysis"] = dict(self.analysis)
         out["outputs"] = [dict(o) for o in self.outputs]
         out["figures"] = [dict(f) for f in self.figures]
@@ -355,13 +366,13 @@ def from_dict(d: Any, where: str = "") -> Scene:
                 fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "
                      f"{', '.join(kinds)}")
             model._add(kind, {k: v for k, v in e.items() if k != "type"}, w)
-    points = d.get("points", [])
-    if not isinstance(points, list):
-        fail(f"{prefix}points", f"expected a list, got {type(points).__name__}")
-    for i, p in enumerate(points):
-        if not isinstance(p, Mapping):
-            _not_object(p, f"{prefix}points[{i}]")
-        model._add_point(p, f"{prefix}points[{i}]")
+    for where, p in _objects(d, "points", prefix):
+        model._add_point(p, where)
+    for where, e in _objects(d, "events", prefix):
+        if "function" in e or "bodies" in e:
+            fail(where, "a scene's event watches an output or a point; a function event is "
+                 "Python only (Model.add_event)")
+        model._add_event(e, where)
     description = d.get("description", "")
     if not isinstance(description, str):
         fail(f"{prefix}description", "expected a string")
@@ -371,6 +382,17 @@ def from_dict(d: Any, where: str = "") -> Scene:
         if not isinstance(value, list):
             fail(f"{prefix}{key}", f"expected a list, got {type(value).__name__}")
     return Scene(model, d.get("analysis", {}), outputs, figures, description)
+
+
+def _objects(d: Mapping[str, Any], key: str, prefix: str) -> List[Tuple[str, Mapping[str, Any]]]:
+    """The entries of the optional list d[key], each an object, with their places."""
+    entries = d.get(key, [])
+    if not isinstance(entries, list):
+        fail(f"{prefix}{key}", f"expected a list, got {type(entries).__name__}")
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, Mapping):
+            _not_object(entry, f"{prefix}{key}[{i}]")
+    return [(f"{prefix}{key}[{i}]", entry) for i, entry in enumerate(entries)]
 
 
 def _not_object(x: Any, where: str) -> NoReturn:

@@ -58,6 +58,78 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   return s;
 }
 
+/// The run's watches (analysis/watches.hpp) from settings["events"], as the Python layer checked
+/// and resolved them: [{"name", "direction", "terminal", "value", "kind", ...}], kind "output"
+/// (with "element", "output"), "point" (with "body" index, "at", "quantity", "component") or
+/// "function" (with "function", "bodies" indices). Each watch is its quantity minus "value".
+/// Built with the GIL held (a function's callable is made here).
+template <class Model>
+std::vector<Watch<Model>> watches_from(const Model& model, const py::dict& settings) {
+  using Space = typename Model::Space;
+  std::vector<Watch<Model>> watches;
+  if (!settings.contains("events")) return watches;
+  const py::list events = settings["events"];
+  for (const py::handle item : events) {
+    const py::dict e = py::reinterpret_borrow<py::dict>(item);
+    Watch<Model> watch;
+    watch.name = e["name"].cast<std::string>();
+    const auto direction = e["direction"].cast<std::string>();
+    watch.crossing = direction == "rising"    ? Crossing::rising
+                     : direction == "falling" ? Crossing::falling
+                                              : Crossing::either;
+    watch.terminal = e["terminal"].cast<bool>();
+    const double value = e["value"].cast<double>();
+    const auto kind = e["kind"].cast<std::string>();
+    if (kind == "output") {
+      watch.function = [&model, element = e["element"].cast<std::string>(),
+                        output = e["output"].cast<std::string>(),
+                        value](const odyn::Workspace<Model>& ws) {
+        return element_output(model, ws, element, output) - value;
+      };
+    } else if (kind == "point") {
+      const int body = e["body"].cast<int>();
+      const auto at = e["at"].cast<std::vector<double>>();
+      typename Space::Vector local;
+      for (int i = 0; i < Space::dim; ++i) local[i] = at.at(static_cast<std::size_t>(i));
+      const bool velocity = e["quantity"].cast<std::string>() == "velocity";
+      const int component = e["component"].cast<int>();
+      watch.function = [=](const odyn::Workspace<Model>& ws) {
+        const auto& frame = ws.frames[static_cast<std::size_t>(body)];
+        return (velocity ? frame.point_velocity(local) : frame.point(local))[component] - value;
+      };
+    } else {
+      const auto bodies = e["bodies"].cast<std::vector<int>>();
+      auto callable = std::make_shared<Callable<Space>>(
+          e["function"], static_cast<int>(bodies.size()), "event '" + watch.name + "'");
+      watch.function = [callable, bodies, value](const odyn::Workspace<Model>& ws) {
+        std::array<const typename Space::Frame*, 2> frames{};
+        for (std::size_t k = 0; k < bodies.size(); ++k)
+          frames[k] = &ws.frames[static_cast<std::size_t>(bodies[k])];
+        double x = 0.0;
+        py::gil_scoped_acquire gil;
+        read_numbers(callable->call_with_frames(ws.t, frames.data()), &x, 1, callable->what());
+        return x - value;
+      };
+    }
+    watches.push_back(std::move(watch));
+  }
+  return watches;
+}
+
+/// A run's events as [{"name", "time", "direction" ("rising" or "falling"), "terminal"}].
+inline py::list event_list(const std::vector<Event>& events) {
+  py::list out;
+  for (const Event& e : events) {
+    py::dict d;
+    d["name"] = e.watch;
+    d["time"] = e.time;
+    d["direction"] = e.direction > 0 ? "rising" : "falling";
+    d["terminal"] = e.terminal;
+    out.append(d);
+  }
+  return out;
+}
+
 inline py::array_t<double> to_array(const std::vector<double>& data, py::ssize_t rows,
                                     std::vector<py::ssize_t> shape_of_row = {}) {
   std::vector<py::ssize_t> shape{rows};
@@ -361,6 +433,7 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
   Running<Box> running(box);
   odyn::Workspace<M> ws(box.model);
   Recorder<M> recorder(box.model);
+  const std::vector<Watch<M>> watches = watches_from(box.model, settings);
   RunSummary summary;
   std::exception_ptr error;
   {
@@ -380,13 +453,15 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
           last_report = Clock::now();
         }
       };
-      summary = odyn::simulate(box.model, ws, s, record, &box.assembled);
+      summary = odyn::simulate(box.model, ws, s, record, &box.assembled, watches);
     } catch (...) {
       error = std::current_exception();
     }
   }
   py::dict out = recorder.to_python();
   out["summary"] = error ? py::object(py::none()) : py::object(run_summary(summary));
+  out["events"] = event_list(summary.events);
+  out["ended_by"] = summary.ended_by.empty() ? py::object(py::none()) : py::str(summary.ended_by);
   out["error"] = error ? python_exception(error) : py::object(py::none());
   return out;
 }
