@@ -545,6 +545,9 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     bodies) or "klu" (the whole matrix, when springs, dampers or bushings join bodies).
     "dense", "cholmod" and "klu" force one.
 
+    The model's events (`Model.add_event`) are located within every step: `Result.events`
+    lists their crossings, and a terminal one ends the run on it (`Result.ended_by`).
+
     The GIL is released during the run (Python callables take it back per call).
     progress(t) is called about every 0.2 s of wall time. Ctrl-C raises `odyn.Interrupted`,
     whose `result` holds the outputs so far; an error during the run gets the partial result
