@@ -136,6 +136,12 @@ std::pair<double, double> constraint_residuals(const Model& model, const Workspa
   return {ws.phi.norm(), velocity_residual.norm()};
 }
 
+/// What an observer becomes inside the analyses: whatever callable a caller passes, the
+/// integrators are instantiated once per model type, not again for each lambda (each of which
+/// would compile every integrator anew). One indirect call per output.
+template <class Model>
+using ObserverFunction = std::function<void(const Workspace<Model>&)>;
+
 namespace detail {
 
 /// A step of size h from the committed state has just carried an element's event function from
@@ -582,16 +588,11 @@ inline void add_statistics(IntegratorStatistics& total, const IntegratorStatisti
 
 }  // namespace detail
 
-/// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
-/// instantiated), from the workspace's state (assembled first, or taken from `start`, see
-/// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
-/// and element blocks up to date, and at the end of a run that a terminal watch ended. The
-/// crossings of `watches` are located and returned in the summary's events.
-template <template <class> class IntegratorType, class Model, class Observer>
-RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe,
-                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
-                         WatchList<Model> watches = {}) {
+/// simulate_with, its observer a function: compiled once per model and integrator type.
+template <template <class> class IntegratorType, class Model>
+RunSummary simulate_with_function(const Model& model, Workspace<Model>& ws,
+                                  const DynamicsSettings& s, const ObserverFunction<Model>& observe,
+                                  AssembledStart<Model>* start, WatchList<Model> watches) {
   using Integrator = IntegratorType<Model>;
   static_assert(StepIntegrator<Integrator>);
   const auto started = std::chrono::steady_clock::now();
@@ -602,7 +603,8 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   summary.integrator = integrator.name();
   summary.setup_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
+  detail::OutputRecorder<Model, const ObserverFunction<Model>> recorder{model, ws, observe,
+                                                                        summary};
   recorder(integrator);
   detail::Watcher<Model> watcher(watches);
   watcher.start(ws);
@@ -614,6 +616,20 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
+}
+
+/// Runs a dynamic analysis with the integrator type chosen at compile time (only that one is
+/// instantiated), from the workspace's state (assembled first, or taken from `start`, see
+/// AssembledStart). `observe(ws)` sees the workspace at t0 and at every output time, with frames
+/// and element blocks up to date, and at the end of a run that a terminal watch ended. The
+/// crossings of `watches` are located and returned in the summary's events.
+template <template <class> class IntegratorType, class Model, class Observer>
+RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                         Observer&& observe,
+                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                         WatchList<Model> watches = {}) {
+  return simulate_with_function<IntegratorType>(
+      model, ws, s, ObserverFunction<Model>(std::ref(observe)), start, watches);
 }
 
 /// The integrator "auto": dop853 with error control (rtol, atol) while it does well; from a
@@ -628,11 +644,10 @@ RunSummary simulate_with(const Model& model, Workspace<Model>& ws, const Dynamic
 /// `integrator_choice` why. `Explicit`, `Stiff` and `Robust` are the three in the run's
 /// coordinates.
 template <template <class> class Explicit, template <class> class Stiff,
-          template <class> class Robust, class Model, class Observer>
-RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                         Observer&& observe,
-                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
-                         WatchList<Model> watches = {}) {
+          template <class> class Robust, class Model>
+RunSummary simulate_auto_function(const Model& model, Workspace<Model>& ws,
+                                  const DynamicsSettings& s, const ObserverFunction<Model>& observe,
+                                  AssembledStart<Model>* start, WatchList<Model> watches) {
   const auto started = std::chrono::steady_clock::now();
   RunSummary summary = detail::start_run(model, ws, s, start);
   const Workspace<Model> assembled = ws;  // for the robust run, if it comes to that
@@ -643,7 +658,8 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
   detail::note_tolerance_floor(s, true, summary);
   summary.setup_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  detail::OutputRecorder<Model, Observer> recorder{model, ws, observe, summary};
+  detail::OutputRecorder<Model, const ObserverFunction<Model>> recorder{model, ws, observe,
+                                                                        summary};
   recorder(*explicit_method);
   detail::Watcher<Model> watcher(watches);
   watcher.start(ws);
@@ -743,6 +759,17 @@ RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const Dynamic
   summary.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
+}
+
+/// The integrator "auto" (see simulate_auto_function) for any observer.
+template <template <class> class Explicit, template <class> class Stiff,
+          template <class> class Robust, class Model, class Observer>
+RunSummary simulate_auto(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                         Observer&& observe,
+                         AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                         WatchList<Model> watches = {}) {
+  return simulate_auto_function<Explicit, Stiff, Robust>(
+      model, ws, s, ObserverFunction<Model>(std::ref(observe)), start, watches);
 }
 
 /// simulate()'s dispatch by the integrator's name, in the coordinates the settings name.
@@ -857,16 +884,11 @@ RunSummary simulate_in_coordinates(const Model& model, Workspace<Model>& ws,
   return summary;
 }
 
-/// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()),
-/// in the settings' coordinates; for "auto", those of choose_coordinates, after the assembly
-/// (which finds redundant equations), the run starting from its state. With `start`, runs after
-/// the first start from its assembled state (see AssembledStart). The crossings of `watches`
-/// (events) are located in every step and returned in the summary; a terminal one ends the run.
-template <class Model, class Observer>
-RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
-                    Observer&& observe,
-                    AssembledStart<std::type_identity_t<Model>>* start = nullptr,
-                    WatchList<Model> watches = {}) {
+/// simulate, its observer a function: the dispatch and every integrator compiled once per model.
+template <class Model>
+RunSummary simulate_function(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                             const ObserverFunction<Model>& observe, AssembledStart<Model>* start,
+                             WatchList<Model> watches) {
   if (s.coordinates != "auto")
     return simulate_in_coordinates(model, ws, s, observe, start, watches);
   const auto& known = integrator_names();
@@ -892,6 +914,20 @@ RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSett
   summary.wall_seconds += assembly_seconds;
   summary.coordinates_choice = choice.reason;
   return summary;
+}
+
+/// Runs a dynamic analysis with the integrator named in the settings (see integrator_names()),
+/// in the settings' coordinates; for "auto", those of choose_coordinates, after the assembly
+/// (which finds redundant equations), the run starting from its state. With `start`, runs after
+/// the first start from its assembled state (see AssembledStart). The crossings of `watches`
+/// (events) are located in every step and returned in the summary; a terminal one ends the run.
+template <class Model, class Observer>
+RunSummary simulate(const Model& model, Workspace<Model>& ws, const DynamicsSettings& s,
+                    Observer&& observe,
+                    AssembledStart<std::type_identity_t<Model>>* start = nullptr,
+                    WatchList<Model> watches = {}) {
+  return simulate_function(model, ws, s, ObserverFunction<Model>(std::ref(observe)), start,
+                           watches);
 }
 
 }  // namespace odyn
