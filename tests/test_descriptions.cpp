@@ -31,7 +31,8 @@ class InventedValues {
     if constexpr (std::is_same_v<T, std::string>) {
       return "element " + k;
     } else if constexpr (std::is_same_v<T, double>) {
-      return k == "C" ? 9.0 : k == "L" ? 0.5 : 0.25;  // the gas force needs C > 1, L > r
+      // The gas force needs C > 1 and L > r, a contact law an exponent of 1 or more.
+      return k == "C" ? 9.0 : k == "L" ? 0.5 : k == "exponent" ? 1.5 : 0.25;
     } else if constexpr (std::is_same_v<T, odyn::BodyId>) {
       return odyn::BodyId{k == "body_b" || k == "piston" ? 2 : 1};
     } else if constexpr (std::is_same_v<T, odyn::Axes>) {

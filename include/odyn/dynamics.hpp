@@ -572,6 +572,15 @@ bool run_integrator(const Model& model, Workspace<Model>& ws, Integrator& integr
   return true;
 }
 
+/// Puts an integrator's committed state into the whole workspace, before another integrator
+/// starts from it. Joint coordinates keep the bodies' absolute positions and velocities up to
+/// date only at outputs (refresh_blocks); between them the workspace's q and v are an output's,
+/// and a run handed over there went on from that output's state at the later time.
+template <class Integrator>
+void complete_workspace(Integrator& integrator) {
+  if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
+}
+
 /// Adds the counters of a later part of a run.
 inline void add_statistics(IntegratorStatistics& total, const IntegratorStatistics& part) {
   total.steps += part.steps;
@@ -684,6 +693,7 @@ RunSummary simulate_auto_function(const Model& model, Workspace<Model>& ws,
           (stiff_from - grid.t0) /
           static_cast<double>(std::max(1L, explicit_method->statistics().steps));
       detail::add_statistics(summary.statistics, explicit_method->statistics());
+      detail::complete_workspace(*explicit_method);
       explicit_method.reset();
       std::optional<Stiff<Model>> stiff;
       bool paid_off = true;
@@ -704,6 +714,7 @@ RunSummary simulate_auto_function(const Model& model, Workspace<Model>& ws,
       if (stiff) detail::add_statistics(summary.statistics, stiff->statistics());
       if (!paid_off) {  // back to dop853, held by stability, to the end
         const double back_at = stiff->time();
+        detail::complete_workspace(*stiff);
         stiff.reset();
         summary.integrator += ", dop853 again from t = " + to_text(back_at) + " s";
         summary.integrator_choice += "; bdf's first " + std::to_string(auto_trial_steps) +

@@ -3,6 +3,7 @@
 // only planar code: 3 coordinates per body and 2-equation pins.
 
 #include "odyn/core/model.hpp"
+#include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
@@ -22,6 +23,8 @@ using Gravity = GravityField<Planar>;
 using PointForce = PointForceT<Planar>;
 using PointTorque = PointTorqueT<Planar>;
 using Tsda = TsdaT<Planar>;
+using CircleLine = SpherePlaneT<Planar>;
+using CircleCircle = SphereSphereT<Planar>;
 
 /// A planar model holding just the element types a scene lists.
 template <class... Elements>
@@ -30,6 +33,6 @@ using Model = odyn::Model<Body, Elements...>;
 /// Every planar element type of the library (what scripting uses).
 using DefaultModel =
     Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver, TranslationalDriver,
-          Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing>;
+          Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, CircleLine, CircleCircle>;
 
 }  // namespace odyn::planar

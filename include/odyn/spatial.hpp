@@ -2,6 +2,7 @@
 // The spatial element catalogue and the model types built from it.
 
 #include "odyn/core/model.hpp"
+#include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
@@ -24,15 +25,17 @@ using Gravity = GravityField<Spatial>;
 using PointForce = PointForceT<Spatial>;
 using PointTorque = PointTorqueT<Spatial>;
 using Tsda = TsdaT<Spatial>;
+using SpherePlane = SpherePlaneT<Spatial>;
+using SphereSphere = SphereSphereT<Spatial>;
 
 /// A spatial model holding just the element types a scene lists.
 template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every spatial element type of the library (what scripting uses).
-using DefaultModel =
-    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
-          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, RevoluteDriver,
-          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing>;
+using DefaultModel = Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed,
+                           Distance, PlanarJoint, InLine, InPlane, Orientation, ParallelAxes,
+                           Perpendicular, RevoluteDriver, TranslationalDriver, Gravity, PointForce,
+                           PointTorque, Tsda, Rsda, Bushing, SpherePlane, SphereSphere>;
 
 }  // namespace odyn::spatial

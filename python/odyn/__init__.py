@@ -27,6 +27,7 @@ Command line: odyn run SCENE (python -m odyn run SCENE).
 from . import _core
 from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
+from .contact import hunt_crossley_dissipation
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
 from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBodyHistory,
@@ -48,6 +49,6 @@ __all__ = [
     "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
     "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
     "ToleranceWarning", "assemble", "constant_velocity", "element_types", "frame", "harmonic",
-    "integrators", "load", "loads", "motion_function", "planar_element_types", "polynomial",
-    "save", "simulate",
+    "hunt_crossley_dissipation", "integrators", "load", "loads", "motion_function",
+    "planar_element_types", "polynomial", "save", "simulate",
 ]

@@ -358,6 +358,67 @@ class SpatialElements(_Adds):
             "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
             stiffness=stiffness, damping=damping, preload=preload, law=law)
 
+    def add_sphere_plane(
+            self, name: str, body_a: str, body_b: str, radius_b: float, *, center_b: Vector = (0,
+            0, 0), point: Vector = (0, 0, 0), normal: Vector = (0, 0, 1), stiffness: float,
+            exponent: float = 1.5, dissipation: float = 0.0, friction: float = 0.0,
+            slip_speed: float = 0.001) -> str:
+        """Compliant contact of a sphere on b with a plane on a (the half-space behind the normal
+        is solid): Hunt-Crossley normal force k delta^n (1 + d delta'), regularized Coulomb
+        friction.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the sphere.
+        radius_b (m): the radius of b's sphere (circle).
+        center_b (m): the centre of b's sphere (circle), in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N).
+        """
+        return self._add_given(
+            "sphere_plane", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            center_b=center_b, point=point, normal=normal, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_sphere_sphere(
+            self, name: str, body_a: str, body_b: str, radius_b: float, *, center_b: Vector = (0,
+            0, 0), radius_a: float, center_a: Vector = (0, 0, 0), stiffness: float,
+            exponent: float = 1.5, dissipation: float = 0.0, friction: float = 0.0,
+            slip_speed: float = 0.001) -> str:
+        """Compliant contact of a sphere on b with a sphere on a: Hunt-Crossley normal force k
+        delta^n (1 + d delta'), regularized Coulomb friction.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the sphere.
+        radius_b (m): the radius of b's sphere (circle).
+        center_b (m): the centre of b's sphere (circle), in b's coordinates.
+        radius_a (m): the radius of a's sphere (circle).
+        center_a (m): the centre of a's sphere (circle), in a's coordinates.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N).
+        """
+        return self._add_given(
+            "sphere_sphere", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
+            exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
             D: float = 0.08, C: float = 9.0, p_atm: float = 101325.0, kappa: float = 1.4,
@@ -628,6 +689,66 @@ class PlanarElements(_Adds):
         return self._add_given(
             "bushing", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
             stiffness=stiffness, damping=damping, preload=preload, law=law)
+
+    def add_circle_line(
+            self, name: str, body_a: str, body_b: str, radius_b: float, *, center_b: Vector = (0,
+            0), point: Vector = (0, 0), normal: Vector = (0, 1), stiffness: float,
+            exponent: float = 1.5, dissipation: float = 0.0, friction: float = 0.0,
+            slip_speed: float = 0.001) -> str:
+        """Compliant contact of a circle on b with a line on a (the half-plane behind the normal is
+        solid): Hunt-Crossley normal force k delta^n (1 + d delta'), regularized Coulomb friction.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the sphere.
+        radius_b (m): the radius of b's sphere (circle).
+        center_b (m): the centre of b's sphere (circle), in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N).
+        """
+        return self._add_given(
+            "circle_line", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            center_b=center_b, point=point, normal=normal, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_circle_circle(
+            self, name: str, body_a: str, body_b: str, radius_b: float, *, center_b: Vector = (0,
+            0), radius_a: float, center_a: Vector = (0, 0), stiffness: float,
+            exponent: float = 1.5, dissipation: float = 0.0, friction: float = 0.0,
+            slip_speed: float = 0.001) -> str:
+        """Compliant contact of a circle on b with a circle on a: Hunt-Crossley normal force k
+        delta^n (1 + d delta'), regularized Coulomb friction.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the sphere.
+        radius_b (m): the radius of b's sphere (circle).
+        center_b (m): the centre of b's sphere (circle), in b's coordinates.
+        radius_a (m): the radius of a's sphere (circle).
+        center_a (m): the centre of a's sphere (circle), in a's coordinates.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N).
+        """
+        return self._add_given(
+            "circle_circle", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
+            exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
 
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,

@@ -61,6 +61,8 @@ def _python_default(kind: str, text: str, dim: int) -> str:
         return "0"  # the zero matrix
     if kind in ("number", "nonnegative", "positive"):
         return repr(float(value))
+    if isinstance(value, list):  # a tuple: a default must not be a mutable list
+        return repr(tuple(value))
     return repr(value)
 
 

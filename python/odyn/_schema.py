@@ -313,11 +313,13 @@ JOINTS = _of("spatial", "joint")
 PLANAR_JOINTS = _of("planar", "joint")
 DRIVERS = _of("spatial", "driver")
 FORCES = _of("spatial", "force")
-assert _of("planar", "driver") == DRIVERS and set(_of("planar", "force")) == set(FORCES)
+PLANAR_FORCES = _of("planar", "force")  # the contacts' planar twins have their own names
+assert _of("planar", "driver") == DRIVERS
 
 #: The element catalogue of each space.
 CATALOGUE = {"spatial": ELEMENTS, "planar": PLANAR_ELEMENTS}
 SPACE_JOINTS = {"spatial": JOINTS, "planar": PLANAR_JOINTS}
+SPACE_FORCES = {"spatial": FORCES, "planar": PLANAR_FORCES}
 
 #: Which joints a driver may name with `joint=` (it takes their bodies and frames).
 DRIVEN_JOINTS = {"revolute_driver": ("revolute",),

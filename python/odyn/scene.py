@@ -52,10 +52,11 @@ from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, int
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
-_SCENE_FORCES = tuple(t for t in _schema.FORCES if t != "user_force")
 #: Element types by section of a scene file, for each space.
 SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _schema.DRIVERS,
-                          "forces": _SCENE_FORCES} for space in SPACES}
+                          "forces": tuple(t for t in _schema.SPACE_FORCES[space]
+                                          if t != "user_force")}
+                  for space in SPACES}
 SECTIONS = SPACE_SECTIONS["spatial"]
 TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "points",
             "events",

@@ -545,6 +545,10 @@ def test_engine_gas_force_is_covered_by_the_engine_tests():
     covers("engine_gas_force")  # tests/python/test_engine.py checks it against the C++ example
 
 
+def test_contacts_are_covered_by_their_own_tests():
+    covers("sphere_plane", "sphere_sphere")  # tests/python/test_contact.py: closed forms
+
+
 def test_every_element_type_is_tested():
     # Runs last in this file (pytest keeps file order).
     assert set(odyn.element_types) == TESTED

@@ -254,6 +254,10 @@ def test_bushing_mount_modes_and_a_scene():
     assert result.body("block").position[-1] == pytest.approx([0, (5 - 2 * G) / 1e4], abs=1e-9)
 
 
+def test_contacts_are_covered_by_their_own_tests():
+    covers("circle_line", "circle_circle")  # tests/python/test_contact.py: closed forms
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

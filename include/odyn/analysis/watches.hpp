@@ -64,7 +64,9 @@ template <class Model>
 class Watcher {
  public:
   explicit Watcher(std::span<const Watch<Model>> watches)
-      : watches_(watches), previous_(watches.size()), current_(watches.size()) {}
+      : watches_(watches), previous_(watches.size()), current_(watches.size()) {
+    crossed_.reserve(watches.size());
+  }
 
   bool empty() const { return watches_.empty(); }
   bool ended() const { return ended_; }
@@ -95,12 +97,12 @@ class Watcher {
     const double h = ws.t - t_n;
     const double tolerance = std::max(1e-12 * std::max(1.0, std::abs(ws.t)), 1e-10 * h);
     pending_.clear();
-    std::vector<std::size_t> crossed;
+    crossed_.clear();
     for (std::size_t i = 0; i < watches_.size(); ++i) {
       current_[i] = value(i, ws);
-      if (direction(i) != 0) crossed.push_back(i);
+      if (direction(i) != 0) crossed_.push_back(i);
     }
-    for (const std::size_t i : crossed) {
+    for (const std::size_t i : crossed_) {
       const int dir = direction(i);
       // The crossing of dir * g, rising.
       const double hi =
@@ -169,6 +171,7 @@ class Watcher {
   std::span<const Watch<Model>> watches_;
   std::vector<double> previous_, current_;  // (watches) at the committed state, at the trial
   std::vector<Event> events_, pending_;     // recorded; located in the step not yet committed
+  std::vector<std::size_t> crossed_;        // the watches that changed sign in the trial step
   double silent_until_ = -std::numeric_limits<double>::infinity();
   double start_time_ = 0.0;
   bool ended_ = false;

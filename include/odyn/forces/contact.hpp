@@ -1,0 +1,328 @@
+#pragma once
+// Compliant contact between a sphere on body b and a plane or another sphere on body a (in the
+// plane: a circle, and a line or a circle). Where the gap g between the surfaces is negative,
+// the penetration delta = -g and its rate delta' give the Hunt-Crossley normal force
+//   F_n = k delta^n (1 + d delta'),  kept >= 0 (no pull as the bodies separate),
+// and the slip velocity v_t (the relative velocity of the contact point, across the normal) a
+// regularized Coulomb friction
+//   F_t = -mu F_n tanh(|v_t| / v_s) v_t / |v_t|,
+// both acting on b at the contact point (the midpoint of the overlap) and opposite on a.
+//
+// With no other force on the pair, an impact at speed v_in leaves at v_out with
+//   d v_in - ln(1 + d v_in) = -d v_out - ln(1 - d v_out),
+// whatever k and n (the first integral of m delta'' = -k delta^n (1 + d delta')): the restitution
+// coefficient depends on d v_in only, falling from 1 at d v_in = 0 (Hunt and Crossley's
+// d = 3 (1 - e) / (2 v_in) holds for e near 1 only).
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "odyn/core/description.hpp"
+#include "odyn/core/element.hpp"
+#include "odyn/core/errors.hpp"
+
+namespace odyn {
+
+/// The contact laws' parameters: Hunt-Crossley normal force, regularized Coulomb friction.
+struct ContactLaw {
+  double stiffness = 0.0;    // k, N/m^n
+  double exponent = 1.5;     // n (3/2: Hertz, for spheres)
+  double dissipation = 0.0;  // d, s/m
+  double friction = 0.0;     // mu
+  double slip_speed = 1e-3;  // v_s, m/s: the slip at which friction reaches tanh(1) mu F_n
+
+  /// The normal force at penetration `depth` (> 0) and its rate.
+  double normal_force(double depth, double rate) const {
+    return std::max(0.0, stiffness * std::pow(depth, exponent) * (1.0 + dissipation * rate));
+  }
+  /// The elastic energy stored at penetration `depth` (> 0).
+  double energy(double depth) const {
+    return stiffness * std::pow(depth, exponent + 1.0) / (exponent + 1.0);
+  }
+  /// mu tanh(s / v_s) / s: the friction force per unit normal force and unit slip velocity.
+  double friction_per_slip(double slip) const {
+    if (friction == 0.0) return 0.0;
+    const double x = slip / slip_speed;
+    return friction * (x > 1e-8 ? std::tanh(x) / slip : 1.0 / slip_speed);
+  }
+};
+
+namespace parameters {
+inline constexpr std::array<Parameter, 5> contact_law{{
+    {"stiffness", "positive", nullptr, "N/m^n", "k: the normal force is k delta^n at rest"},
+    {"exponent", "positive", "1.5", "", "n >= 1 (1.5: Hertz's, for spheres)"},
+    {"dissipation", "nonnegative", "0", "s/m",
+     "d: the normal force is k delta^n (1 + d delta'); for a restitution e at an impact speed "
+     "v, odyn.hunt_crossley_dissipation(e, v)"},
+    {"friction", "nonnegative", "0", "", "mu, the Coulomb friction coefficient"},
+    {"slip_speed", "positive", "0.001", "m/s",
+     "v_s: the friction force is mu F_n tanh(|v_t| / v_s)"},
+}};
+}  // namespace parameters
+
+/// The shapes a sphere on body b touches: a plane (a line in the plane) or a sphere on body a.
+namespace contact_shape {
+
+template <class Space>
+struct Plane {
+  typename Space::Vector point, normal;  // on body a, in a's coordinates; normal unit, outward
+
+  static constexpr const char* type = Space::dim == 3 ? "sphere_plane" : "circle_line";
+  static constexpr std::array<Parameter, 2> parameter_list{{
+      {"point", "vector", "0", "m", "a point of the plane (line) on body a, in a's coordinates"},
+      {"normal", "vector", Space::dim == 3 ? "[0, 0, 1]" : "[0, 1]", "",
+       "the plane's (line's) outward normal, in a's coordinates; b's side of a"},
+  }};
+  static constexpr const char* summary =
+      Space::dim == 3
+          ? "Compliant contact of a sphere on b with a plane on a (the half-space behind the "
+            "normal is solid): Hunt-Crossley normal force k delta^n (1 + d delta'), regularized "
+            "Coulomb friction."
+          : "Compliant contact of a circle on b with a line on a (the half-plane behind the "
+            "normal is solid): Hunt-Crossley normal force k delta^n (1 + d delta'), regularized "
+            "Coulomb friction.";
+  template <class Reader>
+  static Plane read(Reader& r) {
+    return {parameter<typename Space::Vector>(r, "point"),
+            parameter<typename Space::Vector>(r, "normal")};
+  }
+  void check(const std::string& name) {
+    if (!point.allFinite() || !normal.allFinite())
+      throw ModelError(name, "the plane's point and normal must be finite");
+    const double length = normal.norm();
+    if (!(length > 1e-12))
+      throw ModelError(name, "the normal is zero; give the plane's outward direction on body a");
+    normal /= length;
+  }
+  /// The outward unit normal (towards b's sphere at `center`) and the signed distance of that
+  /// centre from the surface.
+  template <class Frame>
+  std::pair<typename Space::Vector, double> towards(const Frame& a,
+                                                    const typename Space::Vector& center) const {
+    const typename Space::Vector n = a.direction(normal);
+    return {n, n.dot(center - a.point(point))};
+  }
+};
+
+template <class Space>
+struct Sphere {
+  typename Space::Vector center;  // on body a, in a's coordinates
+  double radius = 0.0;
+
+  static constexpr const char* type = Space::dim == 3 ? "sphere_sphere" : "circle_circle";
+  static constexpr std::array<Parameter, 2> parameter_list{{
+      {"radius_a", "positive", nullptr, "m", "the radius of a's sphere (circle)"},
+      {"center_a", "vector", "0", "m", "the centre of a's sphere (circle), in a's coordinates"},
+  }};
+  static constexpr const char* summary =
+      Space::dim == 3 ? "Compliant contact of a sphere on b with a sphere on a: Hunt-Crossley "
+                        "normal force k delta^n (1 + d delta'), regularized Coulomb friction."
+                      : "Compliant contact of a circle on b with a circle on a: Hunt-Crossley "
+                        "normal force k delta^n (1 + d delta'), regularized Coulomb friction.";
+  template <class Reader>
+  static Sphere read(Reader& r) {
+    return {parameter<typename Space::Vector>(r, "center_a"), parameter<double>(r, "radius_a")};
+  }
+  void check(const std::string& name) const {
+    if (!center.allFinite()) throw ModelError(name, "the centre on body a must be finite");
+    if (!(radius > 0.0) || !std::isfinite(radius))
+      throw ModelError(name, "radius_a is " + to_text(radius) + "; it must be positive");
+  }
+  template <class Frame>
+  std::pair<typename Space::Vector, double> towards(const Frame& a,
+                                                    const typename Space::Vector& center) const {
+    const typename Space::Vector d = center - a.point(this->center);
+    const double length = d.norm();
+    // Concentric spheres: any direction is as good; a's first axis keeps the force finite.
+    const typename Space::Vector n =
+        length > 0.0 ? typename Space::Vector(d / length) : a.direction(Space::Vector::Unit(0));
+    return {n, length - radius};
+  }
+};
+
+}  // namespace contact_shape
+
+/// A sphere (circle) on body b against a Shape on body a; see the top of this header.
+template <class SpaceT, template <class> class ShapeT>
+class ContactT {
+ public:
+  using Space = SpaceT;
+  using Vector = typename Space::Vector;
+  using Frame = typename Space::Frame;
+  using Shape = ShapeT<Space>;
+  static constexpr int num_bodies = 2;
+  using Input = ElementInput<Space, 2>;
+
+  static constexpr std::array<Parameter, 5> pair{{
+      {"name", "name", nullptr, "", "the element's name"},
+      {"body_a", "body", nullptr, "", "the body with the plane or the first sphere"},
+      {"body_b", "body", nullptr, "", "the body with the sphere"},
+      {"radius_b", "positive", nullptr, "m", "the radius of b's sphere (circle)"},
+      {"center_b", "vector", "0", "m", "the centre of b's sphere (circle), in b's coordinates"},
+  }};
+  static constexpr std::array<Parameter, 12> parameter_list =
+      join(join(pair, Shape::parameter_list), parameters::contact_law);
+  static constexpr std::array<Output, 5> output_list{{
+      {"gap", "m", "the distance between the surfaces; negative while they overlap"},
+      {"gap_rate", "m/s", "the gap's rate, positive as the surfaces separate"},
+      {"normal_force", "N", "F_n, pushing b away from a"},
+      {"slip", "m/s", "|v_t|, the contact point's slip speed"},
+      {"friction_force", "N", "|F_t|, the friction force's magnitude"},
+  }};
+  static constexpr ElementDescription description{Shape::type, "force", Shape::summary,
+                                                  parameter_list, output_list};
+  template <class Reader>
+  static ContactT from_parameters(Reader& r) {
+    const auto name = parameter<std::string>(r, "name");
+    const BodyId a = parameter<BodyId>(r, "body_a"), b = parameter<BodyId>(r, "body_b");
+    const auto center = parameter<Vector>(r, "center_b");
+    const double radius = parameter<double>(r, "radius_b");
+    const Shape shape = Shape::read(r);
+    const ContactLaw law{parameter<double>(r, "stiffness"), parameter<double>(r, "exponent"),
+                         parameter<double>(r, "dissipation"), parameter<double>(r, "friction"),
+                         parameter<double>(r, "slip_speed")};
+    return ContactT(name, a, shape, b, center, radius, law);
+  }
+
+  ContactT(std::string name, BodyId body_a, Shape shape, BodyId body_b, const Vector& center_b,
+           double radius_b, ContactLaw law)
+      : name_(std::move(name)),
+        bodies_{body_a, body_b},
+        shape_(std::move(shape)),
+        center_(center_b),
+        radius_(radius_b),
+        law_(law) {
+    shape_.check(name_);
+    if (!center_.allFinite()) throw ModelError(name_, "the centre on body b must be finite");
+    if (!(radius_ > 0.0) || !std::isfinite(radius_))
+      throw ModelError(name_, "radius_b is " + to_text(radius_) + "; it must be positive");
+    const auto positive = [&](double value, const char* what) {
+      if (!(value > 0.0) || !std::isfinite(value))
+        throw ModelError(name_,
+                         std::string(what) + " is " + to_text(value) + "; it must be positive");
+    };
+    const auto nonnegative = [&](double value, const char* what) {
+      if (!(value >= 0.0) || !std::isfinite(value))
+        throw ModelError(
+            name_, std::string(what) + " is " + to_text(value) + "; it must be zero or positive");
+    };
+    positive(law_.stiffness, "stiffness");
+    if (!(law_.exponent >= 1.0) || !std::isfinite(law_.exponent))
+      throw ModelError(name_, "exponent is " + to_text(law_.exponent) +
+                                  "; it must be 1 or more (below 1 the stiffness is infinite "
+                                  "at first touch)");
+    nonnegative(law_.dissipation, "dissipation");
+    nonnegative(law_.friction, "friction");
+    positive(law_.slip_speed, "slip_speed");
+    if (bodies_[0] == bodies_[1])
+      throw ModelError(name_, "body_a and body_b are the same body; contact acts between two");
+  }
+
+  const std::string& name() const { return name_; }
+  const std::array<BodyId, 2>& bodies() const { return bodies_; }
+  const ContactLaw& law() const { return law_; }
+
+  void evaluate(const Input& in, ForceBlocks<Space, 2>& out) const {
+    const Touch c = touch(in);
+    if (c.gap >= 0.0) {
+      out.force[0].setZero();
+      out.force[1].setZero();
+      return;
+    }
+    const Vector force = force_on_b(c);
+    out.force[0] = -c.jacobian_a.transpose() * force;
+    out.force[1] = c.jacobian_b.transpose() * force;
+  }
+
+  /// Newton-matrix blocks: the normal law's stiffness and damping, which move the friction
+  /// with the normal force, and the friction's damping across the normal (the lever arms' and
+  /// the normal's own change left out, as a Tsda leaves them). The friction's block is its
+  /// secant mu F_n tanh(s / v_s) / s rather than its tangent: on tanh's flat shoulders the
+  /// tangent is near zero, and Newton's iteration would swing from one side of the stick region
+  /// to the other instead of settling in it.
+  void jacobians(const Input& in, ForceBlocks<Space, 2>& out) const {
+    out.stiffness.setZero();
+    out.damping.setZero();
+    const Touch c = touch(in);
+    if (c.gap >= 0.0) return;
+    const double depth = -c.gap, rate = -c.gap_rate;
+    const double normal = law_.normal_force(depth, rate);
+    if (normal <= 0.0) return;  // separating faster than the law pushes: no force near here
+    // dF_n/d(delta) = n k delta^(n-1) (1 + d delta'), dF_n/d(delta') = k delta^n d.
+    const double stiffness = law_.exponent * normal / depth;
+    const double damping = law_.stiffness * std::pow(depth, law_.exponent) * law_.dissipation;
+    const double per_slip = law_.friction_per_slip(c.slip.norm());
+    // The force on b per unit normal force, friction included: F = F_n (n - phi v_t).
+    const Vector per_normal = c.normal - per_slip * c.slip;
+    using Square = Eigen::Matrix<double, Space::dim, Space::dim>;
+    const Square across = Square::Identity() - c.normal * c.normal.transpose();
+    Eigen::Matrix<double, Space::dim, 2 * Space::nv> relative;  // d(v_b - v_a at the point)/dv
+    relative << -c.jacobian_a, c.jacobian_b;
+    const Eigen::Matrix<double, 1, 2 * Space::nv> along = c.normal.transpose() * relative;
+    out.stiffness = (relative.transpose() * (stiffness * per_normal)) * along;
+    out.damping = (relative.transpose() * (damping * per_normal)) * along +
+                  relative.transpose() * ((normal * per_slip) * across) * relative;
+  }
+
+  double potential_energy(const Input& in) const {
+    const double gap = touch(in).gap;
+    return gap < 0.0 ? law_.energy(-gap) : 0.0;
+  }
+
+  std::array<double, 5> outputs(const Input& in) const {
+    const Touch c = touch(in);
+    if (c.gap >= 0.0) return {c.gap, c.gap_rate, 0.0, c.slip.norm(), 0.0};
+    const double normal = law_.normal_force(-c.gap, -c.gap_rate);
+    const double friction = normal * law_.friction_per_slip(c.slip.norm()) * c.slip.norm();
+    return {c.gap, c.gap_rate, normal, c.slip.norm(), friction};
+  }
+
+ private:
+  struct Touch {
+    Vector normal;  // unit, from a towards b
+    double gap = 0.0, gap_rate = 0.0;
+    Vector slip;  // the contact point's relative velocity across the normal
+    typename Space::PointJacobian jacobian_a, jacobian_b;  // at the contact point
+  };
+
+  Touch touch(const Input& in) const {
+    const Frame &a = in.body(0), &b = in.body(1);
+    const Vector center = b.point(center_);
+    const auto [normal, distance] = shape_.towards(a, center);
+    Touch c;
+    c.normal = normal;
+    c.gap = distance - radius_;
+    // The midpoint of the overlap (of the gap while apart), as a body-fixed point of each body.
+    const Vector point = center - (radius_ + 0.5 * c.gap) * normal;
+    const Vector on_a = a.rotation.transpose() * (point - a.position);
+    const Vector on_b = b.rotation.transpose() * (point - b.position);
+    const Vector relative = b.point_velocity(on_b) - a.point_velocity(on_a);
+    c.gap_rate = normal.dot(relative);
+    c.slip = relative - c.gap_rate * normal;
+    c.jacobian_a = a.point_jacobian(on_a);
+    c.jacobian_b = b.point_jacobian(on_b);
+    return c;
+  }
+
+  /// The force on b at the contact point (the touch has gap < 0).
+  Vector force_on_b(const Touch& c) const {
+    const double normal = law_.normal_force(-c.gap, -c.gap_rate);
+    return normal * c.normal - (normal * law_.friction_per_slip(c.slip.norm())) * c.slip;
+  }
+
+  std::string name_;
+  std::array<BodyId, 2> bodies_;
+  Shape shape_;
+  Vector center_;
+  double radius_;
+  ContactLaw law_;
+};
+
+template <class Space>
+using SpherePlaneT = ContactT<Space, contact_shape::Plane>;
+template <class Space>
+using SphereSphereT = ContactT<Space, contact_shape::Sphere>;
+
+}  // namespace odyn
