@@ -30,8 +30,9 @@ bash scripts/setup.sh --no-package
 # their models and integrators) and its test run; the rest builds beside it at a lower priority,
 # one unit at a time (the Python package, then the examples), so that it fills the other core
 # without slowing that chain. One at a time, because memory is the other limit: the sanitizer
-# unit alone takes some 15 GB, each other unit 3 to 4 GB, and a machine that runs out of memory
-# does not fail, it crawls.
+# unit alone peaks at 13.5 GB (20.3 GB before GCC was told to collect its garbage more often,
+# see CMakeLists.txt), each other unit 3 to 4 GB, and a machine that runs out of memory does not
+# fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
