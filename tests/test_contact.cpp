@@ -12,6 +12,8 @@
 
 #include <odyn/odyn.hpp>
 
+#include "hunt_crossley.hpp"
+
 namespace test_contact {
 
 namespace sp = odyn::spatial;
@@ -19,21 +21,12 @@ namespace pl = odyn::planar;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-/// The exit speed of the law's first integral (see the file comment), by bisection.
-double exit_speed(double d, double v_in) {
-  const double target = d * v_in - std::log1p(d * v_in);
-  double lo = 0.0, hi = (1.0 - 1e-15) / d;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (-d * mid - std::log1p(-d * mid) < target ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
+using hunt_crossley::exit_rate;
 
 TEST_CASE("A ball leaves a plane at the speed of the contact law's first integral", "[contact]") {
   const double v_in = 1.5, d = 0.4, radius = 0.05, mass = 0.3;
   const odyn::ContactLaw law{.stiffness = 1e6, .exponent = 1.5, .dissipation = d};
-  const double expected = exit_speed(d, v_in);
+  const double expected = exit_rate(d, v_in);
   for (const char* integrator : {"dop853", "generalized-alpha"}) {
     odyn::DynamicsSettings settings;
     settings.integrator = integrator;

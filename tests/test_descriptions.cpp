@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <catch2/catch.hpp>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -33,6 +34,8 @@ class InventedValues {
     } else if constexpr (std::is_same_v<T, double>) {
       // The gas force needs C > 1 and L > r, a contact law an exponent of 1 or more.
       return k == "C" ? 9.0 : k == "L" ? 0.5 : k == "exponent" ? 1.5 : 0.25;
+    } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+      return k == "lower" ? -0.25 : 0.25;  // a stop's limits, lower below upper
     } else if constexpr (std::is_same_v<T, odyn::BodyId>) {
       return odyn::BodyId{k == "body_b" || k == "piston" ? 2 : 1};
     } else if constexpr (std::is_same_v<T, odyn::Axes>) {
@@ -68,8 +71,8 @@ class InventedValues {
   const odyn::ElementDescription& description_;
 };
 
-/// The parameters a front end hands to from_parameters: all but a driver's `joint`, which it
-/// resolves into the bodies and frames.
+/// The parameters a front end hands to from_parameters: all but a driver's or a stop's `joint`,
+/// which it resolves into the bodies and frames.
 std::set<std::string> handed_over(const odyn::ElementDescription& description) {
   std::set<std::string> out;
   for (const odyn::Parameter& p : description.parameters)

@@ -13,6 +13,7 @@
 #include "odyn/planar/drivers.hpp"
 #include "odyn/planar/fixed.hpp"
 #include "odyn/planar/joint_primitives.hpp"
+#include "odyn/planar/limits.hpp"
 #include "odyn/planar/revolute.hpp"
 #include "odyn/planar/rsda.hpp"
 #include "odyn/planar/translational.hpp"
@@ -31,8 +32,8 @@ template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every planar element type of the library (what scripting uses).
-using DefaultModel =
-    Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver, TranslationalDriver,
-          Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, CircleLine, CircleCircle>;
+using DefaultModel = Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver,
+                           TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda,
+                           Bushing, CircleLine, CircleCircle, RevoluteLimit, TranslationalLimit>;
 
 }  // namespace odyn::planar

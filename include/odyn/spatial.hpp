@@ -13,6 +13,7 @@
 #include "odyn/spatial/drivers.hpp"
 #include "odyn/spatial/fixed.hpp"
 #include "odyn/spatial/joint_primitives.hpp"
+#include "odyn/spatial/limits.hpp"
 #include "odyn/spatial/revolute.hpp"
 #include "odyn/spatial/rsda.hpp"
 #include "odyn/spatial/spherical.hpp"
@@ -33,9 +34,10 @@ template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every spatial element type of the library (what scripting uses).
-using DefaultModel = Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed,
-                           Distance, PlanarJoint, InLine, InPlane, Orientation, ParallelAxes,
-                           Perpendicular, RevoluteDriver, TranslationalDriver, Gravity, PointForce,
-                           PointTorque, Tsda, Rsda, Bushing, SpherePlane, SphereSphere>;
+using DefaultModel =
+    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
+          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, RevoluteDriver,
+          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, SpherePlane,
+          SphereSphere, RevoluteLimit, TranslationalLimit>;
 
 }  // namespace odyn::spatial

@@ -419,6 +419,68 @@ class SpatialElements(_Adds):
             center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
             exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
 
+    def add_revolute_limit(
+            self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
+            on_a: Optional[Frame] = None, body_b: Optional[str] = None,
+            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
+            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            dissipation: float = 0.0) -> str:
+        """Stops on a revolute (or cylindrical) joint's angle: past a limit by delta, a torque k
+        delta^n (1 + d delta') back towards it.
+
+        name: the element's name.
+        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
+        body_a and body_b.
+        body_a: the first body (without joint).
+        on_a (m): the joint's frame on body a (without joint).
+        body_b: the second body (without joint).
+        on_b (m): the joint's frame on body b (without joint).
+        lower (rad): the lower limit of the coordinate; null: no stop below.
+        upper (rad): the upper limit of the coordinate; null: no stop above.
+        stiffness (N m/rad^n): k: the stop pushes back with k delta^n at rest, delta the
+        penetration past the limit.
+        exponent: n >= 1.
+        dissipation (s/rad): d: the push is k delta^n (1 + d delta'); for a restitution e at an
+        impact rate v, odyn.hunt_crossley_dissipation(e, v).
+
+        Outputs (Result.output(name)): angle (rad), rate (rad/s), clearance (rad), torque (N m).
+        """
+        return self._add_given(
+            "revolute_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
+            on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation)
+
+    def add_translational_limit(
+            self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
+            on_a: Optional[Frame] = None, body_b: Optional[str] = None,
+            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
+            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            dissipation: float = 0.0) -> str:
+        """Stops on a translational (or cylindrical) joint's slide: past a limit by delta, a force
+        k delta^n (1 + d delta') back towards it.
+
+        name: the element's name.
+        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
+        body_a and body_b.
+        body_a: the first body (without joint).
+        on_a (m): the joint's frame on body a (without joint).
+        body_b: the second body (without joint).
+        on_b (m): the joint's frame on body b (without joint).
+        lower (m): the lower limit of the coordinate; null: no stop below.
+        upper (m): the upper limit of the coordinate; null: no stop above.
+        stiffness (N/m^n): k: the stop pushes back with k delta^n at rest, delta the penetration
+        past the limit.
+        exponent: n >= 1.
+        dissipation (s/m): d: the push is k delta^n (1 + d delta'); for a restitution e at an
+        impact rate v, odyn.hunt_crossley_dissipation(e, v).
+
+        Outputs (Result.output(name)): position (m), rate (m/s), clearance (m), force (N).
+        """
+        return self._add_given(
+            "translational_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
+            on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation)
+
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
             D: float = 0.08, C: float = 9.0, p_atm: float = 101325.0, kappa: float = 1.4,
@@ -749,6 +811,68 @@ class PlanarElements(_Adds):
             "circle_circle", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
             center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
             exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_revolute_limit(
+            self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
+            on_a: Optional[Frame] = None, body_b: Optional[str] = None,
+            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
+            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            dissipation: float = 0.0) -> str:
+        """Stops on a revolute joint's angle: past a limit by delta, a torque k delta^n (1 + d
+        delta') back towards it.
+
+        name: the element's name.
+        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
+        body_a and body_b.
+        body_a: the first body (without joint).
+        on_a (m): the joint's frame on body a (without joint).
+        body_b: the second body (without joint).
+        on_b (m): the joint's frame on body b (without joint).
+        lower (rad): the lower limit of the coordinate; null: no stop below.
+        upper (rad): the upper limit of the coordinate; null: no stop above.
+        stiffness (N m/rad^n): k: the stop pushes back with k delta^n at rest, delta the
+        penetration past the limit.
+        exponent: n >= 1.
+        dissipation (s/rad): d: the push is k delta^n (1 + d delta'); for a restitution e at an
+        impact rate v, odyn.hunt_crossley_dissipation(e, v).
+
+        Outputs (Result.output(name)): angle (rad), rate (rad/s), clearance (rad), torque (N m).
+        """
+        return self._add_given(
+            "revolute_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
+            on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation)
+
+    def add_translational_limit(
+            self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
+            on_a: Optional[Frame] = None, body_b: Optional[str] = None,
+            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
+            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            dissipation: float = 0.0) -> str:
+        """Stops on a translational joint's slide: past a limit by delta, a force k delta^n (1 + d
+        delta') back towards it.
+
+        name: the element's name.
+        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
+        body_a and body_b.
+        body_a: the first body (without joint).
+        on_a (m): the joint's frame on body a (without joint).
+        body_b: the second body (without joint).
+        on_b (m): the joint's frame on body b (without joint).
+        lower (m): the lower limit of the coordinate; null: no stop below.
+        upper (m): the upper limit of the coordinate; null: no stop above.
+        stiffness (N/m^n): k: the stop pushes back with k delta^n at rest, delta the penetration
+        past the limit.
+        exponent: n >= 1.
+        dissipation (s/m): d: the push is k delta^n (1 + d delta'); for a restitution e at an
+        impact rate v, odyn.hunt_crossley_dissipation(e, v).
+
+        Outputs (Result.output(name)): position (m), rate (m/s), clearance (m), force (N).
+        """
+        return self._add_given(
+            "translational_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
+            on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation)
 
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,

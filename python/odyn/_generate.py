@@ -32,6 +32,7 @@ _ANNOTATIONS: Dict[str, Tuple[str, str]] = {
     "vector": ("Vector", "Vector"),
     "frame": ("Frame", "Frame"),
     "number": ("float", "float"),
+    "optional_number": ("Optional[float]", "Optional[float]"),
     "flag": ("bool", "bool"),
     "nonnegative": ("float", "float"),
     "positive": ("float", "float"),
@@ -201,7 +202,10 @@ def elements_markdown() -> str:
         "example). An element with outputs lists them (`outputs`, optional) and computes them "
         "in `outputs(in)` (`include/odyn/core/outputs.hpp`; `include/odyn/forces/tsda.hpp` is "
         "an example); a stateful one lists the fields of its state that results record "
-        "(`state_fields`, with `state_values(state)`; `include/odyn/core/state_fields.hpp`).",
+        "(`state_fields`, with `state_values(state)`; `include/odyn/core/state_fields.hpp`). "
+        "An element that acts on an existing joint's coordinate takes a `joint` parameter and "
+        "lists the joint types it may name (`joints`); the front ends hand it that joint's "
+        "bodies and frames (`include/odyn/spatial/limits.hpp`).",
         "2. Register it: add the type to `odyn::spatial::DefaultModel` or "
         "`odyn::planar::DefaultModel` and to the matching model type of the Python bindings "
         "(`python/src/bindings.hpp`; a static_assert there fails until it holds every type of "
@@ -230,6 +234,9 @@ def elements_markdown() -> str:
                 default = "required" if p["default"] is None else f"`{p['default']}`"
                 out.append(f"| `{p['name']}` | {p['kind']} | {default} | {p['unit']} | "
                            f"{_cell(p['doc'])} |")
+            if element["joints"]:
+                out += ["", "`joint` names a " + " or ".join(
+                    f"`{j}`" for j in element["joints"]) + " joint."]
             if element["outputs"]:
                 out += ["", "Outputs, recorded at every output time (`result.output(name)`, "
                         "or a scene output column `{\"element\": name, \"output\": ...}`):", "",

@@ -242,6 +242,7 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
         "vector": lambda x, w, b: check_vector(x, w, dim),
         "frame": lambda x, w, b: frame({} if x is None else x, w),
         "number": lambda x, w, b: check_number(x, w),
+        "optional_number": lambda x, w, b: None if x is None else check_number(x, w),
         "flag": lambda x, w, b: check_flag(x, w),
         "nonnegative": lambda x, w, b: check_number(x, w, minimum=0.0),
         "positive": lambda x, w, b: check_number(x, w, positive=True),
@@ -321,9 +322,10 @@ CATALOGUE = {"spatial": ELEMENTS, "planar": PLANAR_ELEMENTS}
 SPACE_JOINTS = {"spatial": JOINTS, "planar": PLANAR_JOINTS}
 SPACE_FORCES = {"spatial": FORCES, "planar": PLANAR_FORCES}
 
-#: Which joints a driver may name with `joint=` (it takes their bodies and frames).
-DRIVEN_JOINTS = {"revolute_driver": ("revolute",),
-                 "translational_driver": ("translational", "cylindrical")}
+#: Which joints a driver or a stop may name with `joint=` (it takes their bodies and frames), in
+#: each space: from the descriptions.
+DRIVEN_JOINTS = {space: {t: tuple(d["joints"]) for t, d in DESCRIPTIONS[space].items()
+                         if d["joints"]} for space in DESCRIPTIONS}
 
 
 def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Collection[str],
@@ -335,13 +337,14 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     kinds = SPACE_KINDS[space]
     params = {k: v for k, v in params.items() if not (k == "joint" and v is None)}
     required = [k for k, (_, default) in spec.items() if default is REQUIRED]
-    if kind in DRIVERS:
+    driven = DRIVEN_JOINTS[space]
+    if kind in driven:
         if "joint" in params:
-            # Drive an existing joint: take its bodies and frames.
+            # Drive or stop an existing joint: take its bodies and frames.
             joint = check_name(params.pop("joint"), f"{where}.joint")
-            if joint not in elements or elements[joint][0] not in DRIVEN_JOINTS[kind]:
-                fail(f"{where}.joint", f"no {' or '.join(DRIVEN_JOINTS[kind])} joint named "
-                     f"'{joint}' before this driver")
+            if joint not in elements or elements[joint][0] not in driven[kind]:
+                fail(f"{where}.joint", f"no {' or '.join(driven[kind])} joint named "
+                     f"'{joint}' before this {'driver' if kind in DRIVERS else 'stop'}")
             for key in ("body_a", "on_a", "body_b", "on_b"):
                 if params.get(key) is not None:
                     fail(f"{where}.{key}",

@@ -289,15 +289,16 @@ using Model =
               sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane, sp::Orientation,
               sp::ParallelAxes, sp::Perpendicular, sp::RevoluteDriver, sp::TranslationalDriver,
               sp::Gravity, sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing,
-              sp::SpherePlane, sp::SphereSphere, EngineGasForce, UserForceT<Spatial, 1>,
-              UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+              sp::SpherePlane, sp::SphereSphere, sp::RevoluteLimit, sp::TranslationalLimit,
+              EngineGasForce, UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
-using PlanarModel = pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
-                              pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity,
-                              pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing,
-                              pl::CircleLine, pl::CircleCircle, PlanarEngineGasForce,
-                              UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
+using PlanarModel =
+    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
+              pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity, pl::PointForce,
+              pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, pl::CircleLine, pl::CircleCircle,
+              pl::RevoluteLimit, pl::TranslationalLimit, PlanarEngineGasForce,
+              UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
 /// DefaultModel): a new element in the library fails this check until the bindings have it.

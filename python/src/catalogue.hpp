@@ -7,6 +7,7 @@
 #include <Python.h>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
@@ -75,6 +76,9 @@ class DictReader {
     } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
       return value.cast<std::vector<std::string>>();
     } else if constexpr (std::is_same_v<T, double>) {
+      return value.cast<double>();
+    } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+      if (value.is_none()) return std::nullopt;
       return value.cast<double>();
     } else if constexpr (std::is_same_v<T, bool>) {
       return value.cast<bool>();

@@ -269,7 +269,7 @@ py::object type_names() {
 
 /// The descriptions of the element types a model type can add, as plain Python values: a list
 /// of {type, category, summary, parameters: [{name, kind, default (JSON text or None), unit,
-/// doc}], outputs and state_fields: [{name, unit, doc}]}.
+/// doc}], outputs and state_fields: [{name, unit, doc}], joints: [the types `joint` may name]}.
 template <class M>
 py::list catalogue() {
   py::list out;
@@ -303,6 +303,9 @@ py::list catalogue() {
     element["parameters"] = parameters;
     element["outputs"] = listed(d->outputs);
     element["state_fields"] = listed(d->state_fields);
+    py::list joints;
+    for (const char* joint : d->joints) joints.append(joint);
+    element["joints"] = joints;
     out.append(element);
   }
   return out;

@@ -549,6 +549,10 @@ def test_contacts_are_covered_by_their_own_tests():
     covers("sphere_plane", "sphere_sphere")  # tests/python/test_contact.py: closed forms
 
 
+def test_stops_are_covered_by_their_own_tests():
+    covers("revolute_limit", "translational_limit")  # tests/python/test_limits.py
+
+
 def test_every_element_type_is_tested():
     # Runs last in this file (pytest keeps file order).
     assert set(odyn.element_types) == TESTED

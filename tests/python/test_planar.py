@@ -258,6 +258,10 @@ def test_contacts_are_covered_by_their_own_tests():
     covers("circle_line", "circle_circle")  # tests/python/test_contact.py: closed forms
 
 
+def test_stops_are_covered_by_their_own_tests():
+    covers("revolute_limit", "translational_limit")  # tests/python/test_limits.py
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

@@ -795,11 +795,13 @@ class JointCoordinates {
     for (int b = 1; b <= model_.num_bodies(); ++b)
       own_blocks_[b] =
           damping_factor * Space::gyroscopic_damping(model_.body(BodyId{b}).inertia, ws_.frames[b]);
-    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    model_.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
       if constexpr (HasForceJacobians<E>) {
         ForceBlocksOf<E> blocks;
-        for (const E& element : pool) {
-          element.jacobians(detail::input_of(element, ws_.frames, ws_.t), blocks);
+        for (std::size_t n = 0; n < pool.size(); ++n) {
+          const E& element = pool[n];
+          force_jacobians(element, detail::input_of(element, ws_.frames, ws_.t),
+                          std::get<type>(ws_.states)[n], blocks);
           for (int k = 0; k < E::num_bodies; ++k) {
             const int b = element.bodies()[k].index;
             if (b == 0) continue;

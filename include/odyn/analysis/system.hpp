@@ -212,11 +212,13 @@ void add_iteration_blocks(const Model& model, const Workspace<Model>& ws, Matrix
   }
   if (stiffness_factor == 0.0 && damping_factor == 0.0) return;
   if (geometric) add_geometric_stiffness(model, ws, target, stiffness_factor);
-  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
     if constexpr (HasForceJacobians<E>) {
       ForceBlocksOf<E> blocks;
-      for (const E& element : pool) {
-        element.jacobians(detail::input_of(element, ws.frames, ws.t), blocks);
+      for (std::size_t k = 0; k < pool.size(); ++k) {
+        const E& element = pool[k];
+        force_jacobians(element, detail::input_of(element, ws.frames, ws.t),
+                        std::get<type>(ws.states)[k], blocks);
         for (int i = 0; i < E::num_bodies; ++i)
           for (int j = 0; j < E::num_bodies; ++j) {
             const BodyId bi = element.bodies()[i], bj = element.bodies()[j];

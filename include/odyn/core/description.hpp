@@ -42,6 +42,7 @@ struct ElementDescription {
   std::span<const Parameter> parameters;
   std::span<const Output> outputs = {};  // what outputs(in) returns, in order
   std::span<const Output> state_fields = {};  // what state_values(state) returns, in order
+  std::span<const char* const> joints = {};   // the joint types a `joint` parameter may name
 };
 
 /// A kind of parameter value, and how it reads in each space.
@@ -51,7 +52,7 @@ struct ParameterKind {
 };
 
 /// Every kind a description may use. A vector's, a wrench's or a matrix's default 0 is zero.
-inline constexpr std::array<ParameterKind, 20> parameter_kinds{{
+inline constexpr std::array<ParameterKind, 21> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
@@ -62,6 +63,7 @@ inline constexpr std::array<ParameterKind, 20> parameter_kinds{{
      "the origin, the z axis, a reference chosen from the other body's), {point, axis} in the "
      "plane (an axis left out is the other body's at the initial pose)"},
     {"number", "a finite number"},
+    {"optional_number", "a finite number, or null for none"},
     {"flag", "true or false"},
     {"nonnegative", "a finite number >= 0"},
     {"positive", "a finite number > 0"},
@@ -105,8 +107,9 @@ constexpr std::array<Parameter, N + M> join(const std::array<Parameter, N>& firs
   return out;
 }
 
-/// True if every parameter of the description has a known kind and a unique name, and every
-/// output and state field a unique name.
+/// True if every parameter of the description has a known kind and a unique name, a `joint`
+/// parameter comes with the joint types it may name, and every output and state field has a
+/// unique name.
 constexpr bool is_well_formed(const ElementDescription& description) {
   const auto same = [](const char* a, const char* b) {
     while (*a != '\0' && *a == *b) ++a, ++b;
@@ -114,6 +117,7 @@ constexpr bool is_well_formed(const ElementDescription& description) {
   };
   for (std::size_t i = 0; i < description.parameters.size(); ++i) {
     if (!is_parameter_kind(description.parameters[i].kind)) return false;
+    if (same(description.parameters[i].kind, "joint") && description.joints.empty()) return false;
     for (std::size_t j = 0; j < i; ++j)
       if (same(description.parameters[i].name, description.parameters[j].name)) return false;
   }

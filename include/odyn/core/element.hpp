@@ -111,11 +111,17 @@ concept FieldForce = requires(const E& e, double mass, const typename E::Space::
 template <class E>
 concept Element = Constraint<E> || ForceElement<E> || FieldForce<E>;
 
-/// Optional: a force element that fills `stiffness` and `damping` in `jacobians(in, out)`.
+/// Optional: a force element that fills `stiffness` and `damping` in `jacobians(in, out)`, or
+/// a stateful one in `jacobians(in, state, out)` (a stop on an angle that counts turns).
 template <class E>
-concept HasForceJacobians = requires(const E& e, const InputOf<E>& in, ForceBlocksOf<E>& out) {
-  e.jacobians(in, out);
-};
+concept HasStatelessForceJacobians =
+    requires(const E& e, const InputOf<E>& in, ForceBlocksOf<E>& out) { e.jacobians(in, out); };
+template <class E>
+concept HasStatefulForceJacobians =
+    StatefulForce<E> && requires(const E& e, const InputOf<E>& in, const typename E::State& s,
+                                 ForceBlocksOf<E>& out) { e.jacobians(in, s, out); };
+template <class E>
+concept HasForceJacobians = HasStatelessForceJacobians<E> || HasStatefulForceJacobians<E>;
 
 /// The blocks of d(Phi_q^T lambda)/dq that an element's constraint forces add to the Newton
 /// matrix (their "geometric stiffness"), body by body: block k is the derivative of body k's
@@ -169,5 +175,16 @@ struct StateOfImpl<E> {
 };
 template <class E>
 using StateOf = typename StateOfImpl<E>::type;
+
+/// Fills a force element's Newton blocks, with its state if its jacobians read one.
+template <class E>
+  requires HasForceJacobians<E>
+void force_jacobians(const E& e, const InputOf<E>& in, const StateOf<E>& state,
+                     ForceBlocksOf<E>& out) {
+  if constexpr (HasStatefulForceJacobians<E>)
+    e.jacobians(in, state, out);
+  else
+    e.jacobians(in, out);
+}
 
 }  // namespace odyn

@@ -47,6 +47,13 @@ inline constexpr std::array<Parameter, 7> driver{{
     {"on_b", "frame", "null", "m", "the joint's frame on body b (without joint)"},
 }};
 
+/// The joint types whose coordinate a driver or a stop takes with `joint=` (the description's
+/// `joints`): a hinge's angle, a slider's slide, and the cylindrical joint's either.
+inline constexpr std::array<const char*, 1> revolute_joints{"revolute"};
+inline constexpr std::array<const char*, 2> turning_joints{"revolute", "cylindrical"};
+inline constexpr std::array<const char*, 1> translational_joints{"translational"};
+inline constexpr std::array<const char*, 2> sliding_joints{"translational", "cylindrical"};
+
 /// A rotational spring-damper-actuator's law.
 inline constexpr std::array<Parameter, 4> rotational_spring{{
     {"stiffness", "number", "0", "N m/rad", "k"},

@@ -19,10 +19,14 @@ class RevoluteDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
   static constexpr ElementDescription description{
-      "revolute_driver", "driver",
+      "revolute_driver",
+      "driver",
       "Revolute driver: the joint angle (b's angle minus a's, from the axes) follows g(t). 1 "
       "equation.",
-      parameters::driver};
+      parameters::driver,
+      {},
+      {},
+      parameters::revolute_joints};
   /// From two bodies and their frames (a front end resolves `joint` into them).
   template <class Reader>
   static RevoluteDriver from_parameters(Reader& r) {
@@ -63,10 +67,14 @@ class TranslationalDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
   static constexpr ElementDescription description{
-      "translational_driver", "driver",
+      "translational_driver",
+      "driver",
       "Translational driver: the slide of b's point along a's axis, from a's point, follows g(t). "
       "1 equation.",
-      parameters::driver};
+      parameters::driver,
+      {},
+      {},
+      parameters::translational_joints};
   /// From two bodies and their frames (a front end resolves `joint` into them).
   template <class Reader>
   static TranslationalDriver from_parameters(Reader& r) {

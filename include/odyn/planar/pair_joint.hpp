@@ -19,8 +19,10 @@
 #include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/core/joint_coordinate.hpp"
 #include "odyn/core/parameter_blocks.hpp"
 #include "odyn/core/planar.hpp"
+#include "odyn/planar/primitives.hpp"
 
 namespace odyn::planar {
 
@@ -69,6 +71,18 @@ class PairJoint {
     return in.body(1).angle - in.body(0).angle + angle_offset_;
   }
   double angle_rate(const Input& in) const { return in.body(1).omega() - in.body(0).omega(); }
+
+  /// The slide of b's point along a's axis, (R_a axis) . (P_b - P_a), as a translational driver
+  /// prescribes it, with its rate and gradient.
+  JointCoordinate<Space> slide(const Input& in) const {
+    ConstraintBlocks<Space, 1, 2> row;
+    primitive::on_line(in.body(0), on_a_.axis, on_a_.point, in.body(1), on_b_.point, row, 0);
+    JointCoordinate<Space> x;
+    x.value = row.phi[0];
+    x.direction << row.jacobian[0].transpose(), row.jacobian[1].transpose();
+    x.set_rate(in);
+    return x;
+  }
 
   /// Completes the axes and the angle's whole turns from the initial pose.
   void bind(const Input& in) {

@@ -21,10 +21,14 @@ namespace odyn::spatial {
 class RevoluteDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
-  static constexpr ElementDescription description{"revolute_driver", "driver",
+  static constexpr ElementDescription description{"revolute_driver",
+                                                  "driver",
                                                   "Revolute driver: the angle of b about a's axis, "
                                                   "from a's reference, follows g(t). 1 equation.",
-                                                  parameters::driver};
+                                                  parameters::driver,
+                                                  {},
+                                                  {},
+                                                  parameters::revolute_joints};
   /// From two bodies and their frames (a front end resolves `joint` into them).
   template <class Reader>
   static RevoluteDriver from_parameters(Reader& r) {
@@ -90,9 +94,13 @@ class TranslationalDriver : public PairJoint {
  public:
   static constexpr int num_equations = 1;
   static constexpr ElementDescription description{
-      "translational_driver", "driver",
+      "translational_driver",
+      "driver",
       "Translational driver: the slide of b's point along a's axis follows g(t). 1 equation.",
-      parameters::driver};
+      parameters::driver,
+      {},
+      {},
+      parameters::sliding_joints};
   /// From two bodies and their frames (a front end resolves `joint` into them).
   template <class Reader>
   static TranslationalDriver from_parameters(Reader& r) {

@@ -7,9 +7,11 @@
 
 #include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
+#include "odyn/core/joint_coordinate.hpp"
 #include "odyn/core/parameter_blocks.hpp"
 #include "odyn/core/spatial.hpp"
 #include "odyn/spatial/joint_frame.hpp"
+#include "odyn/spatial/primitives.hpp"
 
 namespace odyn::spatial {
 
@@ -36,6 +38,18 @@ class PairJoint {
     Space::RotationMatrix columns;
     columns << body.direction(triad.u), body.direction(triad.v), body.direction(triad.w);
     return columns;
+  }
+
+  /// The slide of b's point along a's axis w, (R_a w) . (P_b - P_a), as a translational driver
+  /// prescribes it, with its rate and gradient.
+  JointCoordinate<Space> slide(const Input& in) const {
+    ConstraintBlocks<Space, 1, 2> row;
+    primitive::dot2(in.body(0), on_a_.w, on_a_.point, in.body(1), on_b_.point, row, 0);
+    JointCoordinate<Space> x;
+    x.value = row.phi[0];
+    x.direction << row.jacobian[0].transpose(), row.jacobian[1].transpose();
+    x.set_rate(in);
+    return x;
   }
 
   /// Completes the reference directions from the initial pose (see JointFrame::reference).

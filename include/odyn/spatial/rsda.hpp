@@ -3,20 +3,19 @@
 // With the joint angle theta (b's reference about a's axis, zero at the initial pose unless
 // references are given) the torque on b about the axis is
 //   T = -(k (theta - free_angle) + c theta' ) + actuator(t, theta, theta'),
-// and -T acts on a. The angle counts whole turns: the last accepted angle is kept in the
-// workspace so that a spring wound past +-pi keeps its torque.
+// and -T acts on a. The angle counts whole turns (joint_angle.hpp), so that a spring wound past
+// +-pi keeps its torque.
 
 #include <cmath>
 #include <functional>
-#include <numbers>
 #include <string>
 
-#include "odyn/spatial/pair_joint.hpp"
+#include "odyn/spatial/joint_angle.hpp"
 #include "odyn/spatial/primitives.hpp"
 
 namespace odyn::spatial {
 
-class Rsda : public PairJoint {
+class Rsda : public JointAngle {
  public:
   using Actuator = std::function<double(double t, double angle, double rate)>;
   struct Parameters {
@@ -25,19 +24,12 @@ class Rsda : public PairJoint {
     double free_angle = 0.0;  // rad
     Actuator actuator = {};   // extra torque on b about the axis, N m (optional)
   };
-  struct State {
-    double angle = 0.0;  // unwrapped angle at the last accepted step
-  };
-
   static constexpr std::array<Parameter, 9> parameter_list =
       join(parameters::frame_pair, parameters::rotational_spring);
   static constexpr std::array<Output, 3> output_list{{
       {"angle", "rad", "theta, counting whole turns"},
       {"rate", "rad/s", "theta'"},
       {"torque", "N m", "the torque on b about the axis"},
-  }};
-  static constexpr std::array<Output, 1> state_list{{
-      {"angle", "rad", "the unwrapped angle at the last accepted step"},
   }};
   static constexpr ElementDescription description{
       "rsda",
@@ -55,23 +47,10 @@ class Rsda : public PairJoint {
 
   Rsda(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
        const JointFrame& on_b, Parameters parameters)
-      : PairJoint(std::move(name), body_a, on_a, body_b, on_b), p_(std::move(parameters)) {
+      : JointAngle(std::move(name), body_a, on_a, body_b, on_b), p_(std::move(parameters)) {
     if (!std::isfinite(p_.stiffness) || !std::isfinite(p_.damping) || !std::isfinite(p_.free_angle))
       throw ModelError(name_, "stiffness, damping and free angle must be finite");
   }
-
-  static std::array<double, 1> state_values(const State& state) { return {state.angle}; }
-  State initial_state(const Input& in) const { return {wrapped_angle(in)}; }
-  void advance(const Input& in, State& state) const { state.angle = angle(in, state); }
-
-  /// Joint angle, continuous from the state's angle (the step is far below half a turn).
-  double angle(const Input& in, const State& state) const {
-    const double turn = 2.0 * std::numbers::pi;
-    const double raw = wrapped_angle(in);
-    return raw + turn * std::round((state.angle - raw) / turn);
-  }
-
-  double rate(const Input& in) const { return direction(in).dot(velocities(in)); }
 
   void evaluate(const Input& in, const State& state, ForceBlocks<Space, 2>& out) const {
     const Eigen::Matrix<double, 12, 1> e = direction(in);
@@ -106,25 +85,6 @@ class Rsda : public PairJoint {
   double torque_at(double t, double theta, double theta_rate) const {
     return -p_.stiffness * (theta - p_.free_angle) - p_.damping * theta_rate +
            (p_.actuator ? p_.actuator(t, theta, theta_rate) : 0.0);
-  }
-  double wrapped_angle(const Input& in) const {
-    const auto &a = in.body(0), &b = in.body(1);
-    const Eigen::Vector3d u_b = b.direction(on_b_.u);
-    return std::atan2(a.direction(on_a_.v).dot(u_b), a.direction(on_a_.u).dot(u_b));
-  }
-  /// d(theta)/d(v_a, v_b): the axis, in each body's frame, on the angular parts.
-  Eigen::Matrix<double, 12, 1> direction(const Input& in) const {
-    const Eigen::Vector3d axis = in.body(0).direction(on_a_.w);
-    Eigen::Matrix<double, 12, 1> e = Eigen::Matrix<double, 12, 1>::Zero();
-    e.segment<3>(3) = -in.body(0).rotation.transpose() * axis;
-    e.segment<3>(9) = in.body(1).rotation.transpose() * axis;
-    return e;
-  }
-  Eigen::Matrix<double, 12, 1> velocities(const Input& in) const {
-    Eigen::Matrix<double, 12, 1> v;
-    v << in.body(0).linear_velocity, in.body(0).angular_velocity, in.body(1).linear_velocity,
-        in.body(1).angular_velocity;
-    return v;
   }
 
   Parameters p_;
