@@ -456,8 +456,8 @@ class SpatialElements(_Adds):
             on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
             upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
             dissipation: float = 0.0) -> str:
-        """Stops on a translational (or cylindrical) joint's slide: past a limit by delta, a force
-        k delta^n (1 + d delta') back towards it.
+        """Stops on a translational joint's slide: past a limit by delta, a force k delta^n (1 + d
+        delta') back towards it.
 
         name: the element's name.
         joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
