@@ -14,12 +14,11 @@ For each: the relative error, the steps and the median wall time of 5 runs.
 """
 
 import math
-import statistics
-import time
 
 import numpy as np
 
 import odyn
+from speed_error_table import print_table
 
 G = 9.81
 
@@ -70,16 +69,6 @@ def rolling_error(r):
     return abs(slope * (1.0 + 0.4 * (0.1 / LEVER) ** 2) / (G * math.sin(THETA)) - 1.0)
 
 
-def median_run(build, t_end, settings):
-    walls, result = [], None
-    for _ in range(5):
-        model = build()
-        start = time.perf_counter()
-        result = odyn.simulate(model, t_end=t_end, output_interval=0.01, **settings)
-        walls.append(time.perf_counter() - start)
-    return statistics.median(walls), result
-
-
 CASES = [
     ("auto (defaults)", {}),
     ("dop853, rtol = atol = 1e-6", {"integrator": "dop853", "rtol": 1e-6, "atol": 1e-6}),
@@ -90,15 +79,5 @@ CASES = [
     ("generalized-alpha, h = 1e-5 s", {"integrator": "generalized-alpha", "step": 1e-5}),
 ]
 
-print("| integrator | impact: error of v_out | steps | median wall | "
-      "rolling: error of the acceleration | steps | median wall |")
-print("|---|---|---|---|---|---|---|")
-for label, settings in CASES:
-    row = [label]
-    for build, t_end, error in [(impact, 0.02, impact_error), (rolling, 1.0, rolling_error)]:
-        try:
-            wall, r = median_run(build, t_end, settings)
-            row += [f"{error(r):.1e}", str(r.statistics.steps), f"{1e3 * wall:.1f} ms"]
-        except odyn.Error as failure:
-            row += [f"failed: {str(failure)[:60]}", "", ""]
-    print("| " + " | ".join(row) + " |")
+print_table([("impact: error of v_out", impact, 0.02, impact_error),
+             ("rolling: error of the acceleration", rolling, 1.0, rolling_error)], CASES)

@@ -14,10 +14,9 @@ For each: the relative error, the steps and the median wall time of 5 runs.
 """
 
 import math
-import statistics
-import time
 
 import odyn
+from speed_error_table import print_table
 
 G = 9.81
 
@@ -50,16 +49,6 @@ def resting_error(r):
     return abs(400.0 * delta / (2.0 * G * 0.4 * math.cos(delta)) - 1.0)
 
 
-def median_run(build, t_end, settings):
-    walls, result = [], None
-    for _ in range(5):
-        model = build()
-        start = time.perf_counter()
-        result = odyn.simulate(model, t_end=t_end, output_interval=0.01, **settings)
-        walls.append(time.perf_counter() - start)
-    return statistics.median(walls), result
-
-
 CASES = [
     ("auto (defaults)", {}),
     ("dop853, rtol = atol = 1e-6", {"integrator": "dop853", "rtol": 1e-6, "atol": 1e-6}),
@@ -69,15 +58,5 @@ CASES = [
     ("generalized-alpha, h = 1e-4 s", {"integrator": "generalized-alpha", "step": 1e-4}),
 ]
 
-print("| integrator | door: error of the rebound rate | steps | median wall | "
-      "resting: error of the penetration | steps | median wall |")
-print("|---|---|---|---|---|---|---|")
-for label, settings in CASES:
-    row = [label]
-    for build, t_end, error in [(door, 1.2, door_error), (resting, 4.0, resting_error)]:
-        try:
-            wall, r = median_run(build, t_end, settings)
-            row += [f"{error(r):.1e}", str(r.statistics.steps), f"{1e3 * wall:.1f} ms"]
-        except odyn.Error as failure:
-            row += [f"failed: {str(failure)[:60]}", "", ""]
-    print("| " + " | ".join(row) + " |")
+print_table([("door: error of the rebound rate", door, 1.2, door_error),
+             ("resting: error of the penetration", resting, 4.0, resting_error)], CASES)
