@@ -51,6 +51,9 @@ class InventedValues {
       odyn::planar::JointFrame frame;
       frame.point = k == "on_a" ? Eigen::Vector2d(0.1, 0.2) : Eigen::Vector2d(-0.3, 0.4);
       return frame;
+    } else if constexpr (requires(T joint) { joint.on_a, joint.body_b; }) {
+      // A joint a gear or a rack names: bodies 1 and 2 for the first, 1 and 3 for the second.
+      return T{odyn::BodyId{1}, {}, odyn::BodyId{k == "joint_a" || k == "pinion" ? 2 : 3}, {}};
     } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
       return k == "point_b" ? Eigen::Vector3d(-0.3, 0.0, 0.4) : Eigen::Vector3d(0.1, 0.2, 0.3);
     } else if constexpr (std::is_same_v<T, Eigen::Vector2d>) {

@@ -261,14 +261,18 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
     const double remaining = t_target - integrator.time();
     double h = 0.0;
     if constexpr (can_adapt) h = integrator.proposed_step();
+    // An element that counts turns from its state may ask for shorter steps (LimitsSteps).
+    const double limit = element_step_limit(model, ws);
     if (!adaptive) {
-      const double step = std::ldexp(fixed_step, -step_cut.halvings);
+      const double step = std::min(std::ldexp(fixed_step, -step_cut.halvings), limit);
       const double steps = std::ceil(remaining / step - 1e-9);
       h = remaining / std::max(1.0, steps);
-    } else if (h >= remaining) {
+    } else if (std::min(h, limit) >= remaining) {
       h = remaining;
-    } else if (h > 0.5 * remaining) {
+    } else if (std::min(h, limit) > 0.5 * remaining) {
       h = 0.5 * remaining;  // two even steps rather than a sliver before the target
+    } else {
+      h = std::min(h, limit);
     }
     double g_start = 0.0;
     if constexpr (has_events<Model>()) g_start = event_function(model, ws);
@@ -385,7 +389,7 @@ bool advance_with_dense_output(const Model& model, Workspace<Model>& ws, Integra
   };
   while (k <= grid.count) {
     const double remaining = t_end - integrator.time();
-    double h = std::min(integrator.proposed_step(), remaining);
+    double h = std::min({integrator.proposed_step(), element_step_limit(model, ws), remaining});
     if (h < remaining && h > 0.5 * remaining) h = 0.5 * remaining;  // no sliver before the end
     double g_start = 0.0;
     if constexpr (has_events<Model>()) g_start = event_function(model, ws);

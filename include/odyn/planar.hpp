@@ -2,6 +2,7 @@
 // The planar element catalogue and the model types built from it. A planar model instantiates
 // only planar code: 3 coordinates per body and 2-equation pins.
 
+#include "odyn/core/gear_pairs.hpp"
 #include "odyn/core/model.hpp"
 #include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
@@ -26,14 +27,21 @@ using PointTorque = PointTorqueT<Planar>;
 using Tsda = TsdaT<Planar>;
 using CircleLine = SpherePlaneT<Planar>;
 using CircleCircle = SphereSphereT<Planar>;
+using Gear = GearT<PairJoint, JointFrame>;
+using RackPinion = RackPinionT<PairJoint, JointFrame>;
+
+/// The joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter names.
+inline constexpr auto turning_joint_types = parameters::revolute_joints;
+inline constexpr auto sliding_joint_types = parameters::translational_joints;
 
 /// A planar model holding just the element types a scene lists.
 template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every planar element type of the library (what scripting uses).
-using DefaultModel = Model<Revolute, Translational, Fixed, Distance, InLine, RevoluteDriver,
-                           TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda,
-                           Bushing, CircleLine, CircleCircle, RevoluteLimit, TranslationalLimit>;
+using DefaultModel =
+    Model<Revolute, Translational, Fixed, Distance, InLine, Gear, RackPinion, RevoluteDriver,
+          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, CircleLine,
+          CircleCircle, RevoluteLimit, TranslationalLimit>;
 
 }  // namespace odyn::planar

@@ -16,6 +16,7 @@
 #include "odyn/spatial/limits.hpp"
 #include "odyn/spatial/revolute.hpp"
 #include "odyn/spatial/rsda.hpp"
+#include "odyn/spatial/screw_joint.hpp"
 #include "odyn/spatial/spherical.hpp"
 #include "odyn/spatial/translational.hpp"
 #include "odyn/spatial/universal.hpp"
@@ -28,6 +29,12 @@ using PointTorque = PointTorqueT<Spatial>;
 using Tsda = TsdaT<Spatial>;
 using SpherePlane = SpherePlaneT<Spatial>;
 using SphereSphere = SphereSphereT<Spatial>;
+using Gear = GearT<PairJoint, JointFrame>;
+using RackPinion = RackPinionT<PairJoint, JointFrame>;
+
+/// The joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter names.
+inline constexpr auto turning_joint_types = parameters::turning_joints;
+inline constexpr auto sliding_joint_types = parameters::sliding_joints;
 
 /// A spatial model holding just the element types a scene lists.
 template <class... Elements>
@@ -36,8 +43,8 @@ using Model = odyn::Model<Body, Elements...>;
 /// Every spatial element type of the library (what scripting uses).
 using DefaultModel =
     Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
-          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, RevoluteDriver,
-          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, SpherePlane,
-          SphereSphere, RevoluteLimit, TranslationalLimit>;
+          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion, ScrewJoint,
+          RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda,
+          Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit>;
 
 }  // namespace odyn::spatial

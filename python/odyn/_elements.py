@@ -210,6 +210,55 @@ class SpatialElements(_Adds):
         return self._add_given(
             "perpendicular", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
 
+    def add_gear(self, name: str, joint_a: str, joint_b: str, ratio: float) -> str:
+        """Gear pair: joint_b's angle turns by `ratio` times joint_a's, for any number of turns. 1
+        equation.
+
+        name: the element's name.
+        joint_a: the first gear's joint (its angle theta_a).
+        joint_b: the second gear's joint (its angle theta_b).
+        ratio: theta_b' / theta_a', nonzero; negative when b turns against a about axes pointing
+        alike.
+
+        Outputs (Result.output(name)): angle_a (rad), angle_b (rad).
+        """
+        return self._add_given("gear", name=name, joint_a=joint_a, joint_b=joint_b, ratio=ratio)
+
+    def add_rack_pinion(self, name: str, pinion: str, rack: str, radius: float) -> str:
+        """Rack and pinion: the rack's joint slides by `radius` times the pinion's joint angle. 1
+        equation.
+
+        name: the element's name.
+        pinion: the pinion's joint (its angle theta).
+        rack: the rack's joint (its slide s).
+        radius (m): s' / theta': the pinion's pitch radius, nonzero, its sign the rack's direction.
+
+        Outputs (Result.output(name)): angle (rad), slide (m).
+        """
+        return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
+
+    def add_screw(
+            self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
+            on_a: Optional[Frame] = None, body_b: Optional[str] = None,
+            on_b: Optional[Frame] = None, pitch: float) -> str:
+        """Screw: b slides along a's axis by `pitch` per turn of b about it (with a cylindrical
+        joint: a lead screw). 1 equation.
+
+        name: the element's name.
+        joint: the joint whose coordinates the element takes (its bodies and frames are taken); or
+        give body_a and body_b.
+        body_a: the first body (without joint).
+        on_a (m): the joint's frame on body a (without joint).
+        body_b: the second body (without joint).
+        on_b (m): the joint's frame on body b (without joint).
+        pitch (m): the slide per turn, nonzero; negative for a left-handed thread.
+
+        Outputs (Result.output(name)): angle (rad), slide (m).
+        """
+        return self._add_given(
+            "screw", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
+            pitch=pitch)
+
     def add_revolute_driver(
             self, name: str, motion: Mapping[str, Any], *, joint: Optional[str] = None,
             body_a: Optional[str] = None, on_a: Optional[Frame] = None,
@@ -429,8 +478,8 @@ class SpatialElements(_Adds):
         delta^n (1 + d delta') back towards it.
 
         name: the element's name.
-        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
-        body_a and body_b.
+        joint: the joint whose coordinates the element takes (its bodies and frames are taken); or
+        give body_a and body_b.
         body_a: the first body (without joint).
         on_a (m): the joint's frame on body a (without joint).
         body_b: the second body (without joint).
@@ -460,8 +509,8 @@ class SpatialElements(_Adds):
         delta') back towards it.
 
         name: the element's name.
-        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
-        body_a and body_b.
+        joint: the joint whose coordinates the element takes (its bodies and frames are taken); or
+        give body_a and body_b.
         body_a: the first body (without joint).
         on_a (m): the joint's frame on body a (without joint).
         body_b: the second body (without joint).
@@ -606,6 +655,33 @@ class PlanarElements(_Adds):
         """
         return self._add_given(
             "inline", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
+    def add_gear(self, name: str, joint_a: str, joint_b: str, ratio: float) -> str:
+        """Gear pair: joint_b's angle turns by `ratio` times joint_a's, for any number of turns. 1
+        equation.
+
+        name: the element's name.
+        joint_a: the first gear's joint (its angle theta_a).
+        joint_b: the second gear's joint (its angle theta_b).
+        ratio: theta_b' / theta_a', nonzero; negative when b turns against a about axes pointing
+        alike.
+
+        Outputs (Result.output(name)): angle_a (rad), angle_b (rad).
+        """
+        return self._add_given("gear", name=name, joint_a=joint_a, joint_b=joint_b, ratio=ratio)
+
+    def add_rack_pinion(self, name: str, pinion: str, rack: str, radius: float) -> str:
+        """Rack and pinion: the rack's joint slides by `radius` times the pinion's joint angle. 1
+        equation.
+
+        name: the element's name.
+        pinion: the pinion's joint (its angle theta).
+        rack: the rack's joint (its slide s).
+        radius (m): s' / theta': the pinion's pitch radius, nonzero, its sign the rack's direction.
+
+        Outputs (Result.output(name)): angle (rad), slide (m).
+        """
+        return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
 
     def add_revolute_driver(
             self, name: str, motion: Mapping[str, Any], *, joint: Optional[str] = None,
@@ -822,8 +898,8 @@ class PlanarElements(_Adds):
         delta') back towards it.
 
         name: the element's name.
-        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
-        body_a and body_b.
+        joint: the joint whose coordinates the element takes (its bodies and frames are taken); or
+        give body_a and body_b.
         body_a: the first body (without joint).
         on_a (m): the joint's frame on body a (without joint).
         body_b: the second body (without joint).
@@ -853,8 +929,8 @@ class PlanarElements(_Adds):
         delta') back towards it.
 
         name: the element's name.
-        joint: the joint whose coordinate is limited (its bodies and frames are taken); or give
-        body_a and body_b.
+        joint: the joint whose coordinates the element takes (its bodies and frames are taken); or
+        give body_a and body_b.
         body_a: the first body (without joint).
         on_a (m): the joint's frame on body a (without joint).
         body_b: the second body (without joint).

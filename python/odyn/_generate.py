@@ -29,6 +29,8 @@ _ANNOTATIONS: Dict[str, Tuple[str, str]] = {
     "body": ("str", "str"),
     "bodies": ("Sequence[str]", "Sequence[str]"),
     "joint": ("str", "str"),
+    "turning_joint": ("str", "str"),
+    "sliding_joint": ("str", "str"),
     "vector": ("Vector", "Vector"),
     "frame": ("Frame", "Frame"),
     "number": ("float", "float"),

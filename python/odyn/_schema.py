@@ -234,11 +234,24 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
             return x
         return check_vector(x, where) if dim == 3 else check_number(x, where)
 
+    def joint_reference(x, where, bodies):
+        # check_element resolved a joint's name into its bodies and frames; a scene saved
+        # from a model holds them so.
+        if isinstance(x, str):
+            fail(where, f"no joint named '{x}' before this element")
+        check_keys(x, where, ["body_a", "on_a", "body_b", "on_b"], ["body_a", "body_b"])
+        return {"body_a": _body(x["body_a"], f"{where}.body_a", bodies),
+                "on_a": frame(x.get("on_a") or {}, f"{where}.on_a"),
+                "body_b": _body(x["body_b"], f"{where}.body_b", bodies),
+                "on_b": frame(x.get("on_b") or {}, f"{where}.on_b")}
+
     return {
         "name": lambda x, w, b: check_name(x, w),
         "body": _body,
         "bodies": _bodies,
         "joint": lambda x, w, b: check_name(x, w),
+        "turning_joint": joint_reference,
+        "sliding_joint": joint_reference,
         "vector": lambda x, w, b: check_vector(x, w, dim),
         "frame": lambda x, w, b: frame({} if x is None else x, w),
         "number": lambda x, w, b: check_number(x, w),
@@ -322,6 +335,12 @@ CATALOGUE = {"spatial": ELEMENTS, "planar": PLANAR_ELEMENTS}
 SPACE_JOINTS = {"spatial": JOINTS, "planar": PLANAR_JOINTS}
 SPACE_FORCES = {"spatial": FORCES, "planar": PLANAR_FORCES}
 
+#: Which joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter may
+#: name, in each space: from the compiled core.
+JOINT_KINDS = {space: {kind: tuple(types) for kind, types in kinds.items()}
+               for space, kinds in (("spatial", _core.joint_kinds),
+                                    ("planar", _core.planar_joint_kinds))}
+
 #: Which joints a driver or a stop may name with `joint=` (it takes their bodies and frames), in
 #: each space: from the descriptions.
 DRIVEN_JOINTS = {space: {t: tuple(d["joints"]) for t, d in DESCRIPTIONS[space].items()
@@ -352,6 +371,15 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
                 params[key] = elements[joint][1][key]
         else:
             required += ["body_a", "body_b"]
+    for key, (param_kind, _) in spec.items():
+        if param_kind in JOINT_KINDS[space] and isinstance(params.get(key), str):
+            # The name of a joint added before: the element takes its bodies and frames.
+            joint = check_name(params[key], f"{where}.{key}")
+            types = JOINT_KINDS[space][param_kind]
+            if joint not in elements or elements[joint][0] not in types:
+                fail(f"{where}.{key}", f"no {' or '.join(types)} joint named '{joint}' before "
+                     f"this {kind}")
+            params[key] = {k: elements[joint][1][k] for k in ("body_a", "on_a", "body_b", "on_b")}
     check_keys(params, where, list(spec), required)
     out: Dict[str, Any] = {}
     for key, (param_kind, default) in spec.items():

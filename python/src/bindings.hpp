@@ -287,17 +287,18 @@ using PlanarEngineGasForce = engine::planar::GasForce;
 using Model =
     sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
               sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane, sp::Orientation,
-              sp::ParallelAxes, sp::Perpendicular, sp::RevoluteDriver, sp::TranslationalDriver,
-              sp::Gravity, sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing,
-              sp::SpherePlane, sp::SphereSphere, sp::RevoluteLimit, sp::TranslationalLimit,
-              EngineGasForce, UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+              sp::ParallelAxes, sp::Perpendicular, sp::Gear, sp::RackPinion, sp::ScrewJoint,
+              sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity, sp::PointForce,
+              sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing, sp::SpherePlane, sp::SphereSphere,
+              sp::RevoluteLimit, sp::TranslationalLimit, EngineGasForce, UserForceT<Spatial, 1>,
+              UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
 using PlanarModel =
-    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
-              pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity, pl::PointForce,
-              pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, pl::CircleLine, pl::CircleCircle,
-              pl::RevoluteLimit, pl::TranslationalLimit, PlanarEngineGasForce,
+    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine, pl::Gear,
+              pl::RackPinion, pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity,
+              pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, pl::CircleLine,
+              pl::CircleCircle, pl::RevoluteLimit, pl::TranslationalLimit, PlanarEngineGasForce,
               UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its

@@ -50,6 +50,13 @@ struct FrameFunction<std::function<Vector(double, const Frame&)>> : std::true_ty
 };
 
 template <class T>
+struct IsJointReference : std::false_type {};
+template <class F>
+struct IsJointReference<parameters::JointReference<F>> : std::true_type {
+  using Frame = F;
+};
+
+template <class T>
 inline constexpr bool always_false = false;
 
 }  // namespace detail
@@ -88,21 +95,14 @@ class DictReader {
       return !value.is_none() && value.cast<std::string>() == "body" ? Axes::body : Axes::global;
     } else if constexpr (std::is_same_v<T, Motion>) {
       return motion(values_, what_);
-    } else if constexpr (std::is_same_v<T, sp::JointFrame>) {
-      sp::JointFrame frame;
-      if (value.is_none()) return frame;
+    } else if constexpr (std::is_same_v<T, sp::JointFrame> || std::is_same_v<T, pl::JointFrame>) {
+      return joint_frame<T>(value);
+    } else if constexpr (detail::IsJointReference<T>::value) {
+      // A joint added before, which the Python layer resolved into its bodies and frames.
+      using Frame = typename detail::IsJointReference<T>::Frame;
       const py::dict d = value.cast<py::dict>();
-      if (present(d, "point")) frame.point = d["point"].cast<Eigen::Vector3d>();
-      if (present(d, "axis")) frame.axis = d["axis"].cast<Eigen::Vector3d>();
-      if (present(d, "reference")) frame.reference = d["reference"].cast<Eigen::Vector3d>();
-      return frame;
-    } else if constexpr (std::is_same_v<T, pl::JointFrame>) {
-      pl::JointFrame frame;  // an axis left out stays zero: the other body's at the start
-      if (value.is_none()) return frame;
-      const py::dict d = value.cast<py::dict>();
-      if (present(d, "point")) frame.point = d["point"].cast<Eigen::Vector2d>();
-      if (present(d, "axis")) frame.axis = d["axis"].cast<Eigen::Vector2d>();
-      return frame;
+      return T{model_.body(d["body_a"].cast<std::string>()), joint_frame<Frame>(d["on_a"]),
+               model_.body(d["body_b"].cast<std::string>()), joint_frame<Frame>(d["on_b"])};
     } else if constexpr (detail::IsFixedSquare<T>::value) {
       return value.cast<T>();  // the Python layer made a diagonal a full matrix
     } else if constexpr (detail::VectorLaw<T>::value) {
@@ -146,6 +146,18 @@ class DictReader {
  private:
   static bool present(const py::dict& d, const char* key) {
     return d.contains(key) && !d[key].is_none();
+  }
+  template <class Frame>
+  static Frame joint_frame(const py::object& value) {
+    Frame frame;  // a planar axis left out stays zero: the other body's at the start
+    if (value.is_none()) return frame;
+    const py::dict d = value.cast<py::dict>();
+    using Vector = decltype(frame.point);
+    if (present(d, "point")) frame.point = d["point"].cast<Vector>();
+    if (present(d, "axis")) frame.axis = d["axis"].cast<Vector>();
+    if constexpr (std::is_same_v<Frame, sp::JointFrame>)
+      if (present(d, "reference")) frame.reference = d["reference"].cast<Vector>();
+    return frame;
   }
   bool declares(const char* key) const {
     for (const Parameter& p : description_.parameters)

@@ -317,6 +317,27 @@ py::list kinds() {
   return out;
 }
 
+/// {"turning_joint": [types], "sliding_joint": [types]}: what those kinds may name in a space.
+template <class Kinds>
+py::dict joint_kinds() {
+  py::dict out;
+  py::list turning, sliding;
+  for (const char* type : Kinds::turning_joint_types) turning.append(type);
+  for (const char* type : Kinds::sliding_joint_types) sliding.append(type);
+  out["turning_joint"] = turning;
+  out["sliding_joint"] = sliding;
+  return out;
+}
+
+struct SpatialJointKinds {
+  static constexpr auto turning_joint_types = odyn::spatial::turning_joint_types;
+  static constexpr auto sliding_joint_types = odyn::spatial::sliding_joint_types;
+};
+struct PlanarJointKinds {
+  static constexpr auto turning_joint_types = odyn::planar::turning_joint_types;
+  static constexpr auto sliding_joint_types = odyn::planar::sliding_joint_types;
+};
+
 }  // namespace
 
 }  // namespace odyn::python
@@ -352,6 +373,8 @@ PYBIND11_MODULE(_core, m) {
   m.attr("element_catalogue") = catalogue<Model>();
   m.attr("planar_element_catalogue") = catalogue<PlanarModel>();
   m.attr("parameter_kinds") = kinds();
+  m.attr("joint_kinds") = joint_kinds<SpatialJointKinds>();
+  m.attr("planar_joint_kinds") = joint_kinds<PlanarJointKinds>();
   bind_integrators(m);
   bind_spatial_analyses(m);
   bind_planar_analyses(m);

@@ -87,7 +87,7 @@ def test_the_compiled_core_refuses_unknown_keys_too():
                        r"expected one of name, acceleration"):
         core.add_element("gravity", {"name": "g", "acceleration": [0, 0, -9.81], "bogus": 1})
     with pytest.raises(_core.ModelError, match="unknown spatial element type"):
-        core.add_element("gear", {"name": "g"})
+        core.add_element("worm_drive", {"name": "g"})
 
 
 def test_spatial_joint_frames_default_to_the_body_origin_and_z():
@@ -124,8 +124,8 @@ def test_the_command_line_lists_the_catalogue(capsys):
     out = capsys.readouterr().out
     assert out.startswith("inline (planar joint): In-line primitive")
     assert "on_a" in out and "frame, m; default null" in out
-    assert cli.main(["elements", "gear"]) == 1
-    assert "no spatial element type 'gear'" in capsys.readouterr().err
+    assert cli.main(["elements", "worm_drive"]) == 1
+    assert "no spatial element type 'worm_drive'" in capsys.readouterr().err
 
 
 def test_a_new_element_reaches_scene_files_with_no_code_of_its_own():

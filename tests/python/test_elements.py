@@ -553,6 +553,10 @@ def test_stops_are_covered_by_their_own_tests():
     covers("revolute_limit", "translational_limit")  # tests/python/test_limits.py
 
 
+def test_gears_are_covered_by_their_own_tests():
+    covers("gear", "rack_pinion", "screw")  # tests/python/test_gears.py
+
+
 def test_every_element_type_is_tested():
     # Runs last in this file (pytest keeps file order).
     assert set(odyn.element_types) == TESTED

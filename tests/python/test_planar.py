@@ -262,6 +262,10 @@ def test_stops_are_covered_by_their_own_tests():
     covers("revolute_limit", "translational_limit")  # tests/python/test_limits.py
 
 
+def test_gears_are_covered_by_their_own_tests():
+    covers("gear", "rack_pinion")  # tests/python/test_gears.py
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

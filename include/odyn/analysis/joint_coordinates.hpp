@@ -68,6 +68,7 @@
 #include <numeric>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "odyn/analysis/sparse_kkt.hpp"
@@ -226,9 +227,10 @@ class JointCoordinates {
   /// The closures' Phi and blocks, and their rows of C in spatial form (see ClosureBlock).
   void evaluate_constraints() {
     std::size_t next = 0;
-    for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int model_row) {
+    for_each_closure([&]<class E>(const E& element, const StateOf<E>& state, BlocksOf<E>& blocks,
+                                  int row, int model_row) {
       constexpr int m = E::num_equations;
-      element.evaluate(detail::input_of(element, ws_.frames, ws_.t), blocks);
+      evaluate_constraint(element, detail::input_of(element, ws_.frames, ws_.t), state, blocks);
       phi_.segment<m>(row) = blocks.phi;
       phi_t_.segment<m>(row) = blocks.phi_t;
       ws_.phi.template segment<m>(model_row) = blocks.phi;
@@ -313,9 +315,10 @@ class JointCoordinates {
     }
     // The closures' right-hand side in spatial form: gamma less Phi_linear (omega x v_centre),
     // the part of the centre's acceleration that the spatial acceleration leaves out.
-    for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int) {
+    for_each_closure([&]<class E>(const E& element, const StateOf<E>& state, BlocksOf<E>& blocks,
+                                  int row, int) {
       auto g = closure_rhs_.segment<E::num_equations>(row);
-      g = element.gamma(detail::input_of(element, ws_.frames, ws_.t));
+      g = constraint_gamma(element, detail::input_of(element, ws_.frames, ws_.t), state);
       for (int k = 0; k < E::num_bodies; ++k) {
         const int b = element.bodies()[k].index;
         if (b == 0) continue;
@@ -658,7 +661,8 @@ class JointCoordinates {
     }
     // Each body's constraint forces Phi_q^T lambda, from the closures first.
     constraint_force_.setZero();
-    for_each_closure([&]<class E>(const E& element, BlocksOf<E>& blocks, int row, int model_row) {
+    for_each_closure([&]<class E>(const E& element, const StateOf<E>&, BlocksOf<E>& blocks, int row,
+                                  int model_row) {
       const auto lambda = lambda_.segment<E::num_equations>(row);
       ws_.lambda.template segment<E::num_equations>(model_row) = lambda;
       for (int k = 0; k < E::num_bodies; ++k) {
@@ -1060,7 +1064,8 @@ class JointCoordinates {
         const auto& closures = closures_[type];
         for (std::size_t c = 0; c < closures.size(); ++c) {
           const std::size_t i = closures[c].index;
-          f(pool[i], blocks[i], closures[c].row, rows[i]);
+          f(pool[i], std::as_const(std::get<type>(ws_.states)[i]), blocks[i], closures[c].row,
+            rows[i]);
         }
       }
     });

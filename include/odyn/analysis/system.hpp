@@ -44,7 +44,8 @@ void evaluate_constraints(const Model& model, Workspace<Model>& ws) {
       auto& blocks = std::get<type>(ws.blocks);
       const auto& rows = model.template rows<E>();
       for (std::size_t i = 0; i < pool.size(); ++i) {
-        pool[i].evaluate(detail::input_of(pool[i], ws.frames, ws.t), blocks[i]);
+        evaluate_constraint(pool[i], detail::input_of(pool[i], ws.frames, ws.t),
+                            std::get<type>(ws.states)[i], blocks[i]);
         ws.phi.template segment<E::num_equations>(rows[i]) = blocks[i].phi;
         ws.phi_t.template segment<E::num_equations>(rows[i]) = blocks[i].phi_t;
       }
@@ -55,12 +56,12 @@ void evaluate_constraints(const Model& model, Workspace<Model>& ws) {
 /// Acceleration right-hand side gamma at (frames, t).
 template <class Model>
 void evaluate_gamma(const Model& model, Workspace<Model>& ws) {
-  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
     if constexpr (Constraint<E>) {
       const auto& rows = model.template rows<E>();
       for (std::size_t i = 0; i < pool.size(); ++i)
-        ws.gamma.template segment<E::num_equations>(rows[i]) =
-            pool[i].gamma(detail::input_of(pool[i], ws.frames, ws.t));
+        ws.gamma.template segment<E::num_equations>(rows[i]) = constraint_gamma(
+            pool[i], detail::input_of(pool[i], ws.frames, ws.t), std::get<type>(ws.states)[i]);
     }
   });
 }
@@ -245,11 +246,11 @@ void mass_times(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 }
 
-/// Stateful force elements take their step: called once per accepted step.
+/// Stateful elements take their step: called once per accepted step.
 template <class Model>
 void advance_states(const Model& model, Workspace<Model>& ws) {
   model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-    if constexpr (StatefulForce<E>) {
+    if constexpr (Stateful<E>) {
       auto& states = std::get<type>(ws.states);
       for (std::size_t i = 0; i < pool.size(); ++i)
         pool[i].advance(detail::input_of(pool[i], ws.frames, ws.t), states[i]);
@@ -257,11 +258,27 @@ void advance_states(const Model& model, Workspace<Model>& ws) {
   });
 }
 
-/// Stateful force elements start from the current frames.
+/// The longest next step the elements allow from the workspace's state (LimitsSteps);
+/// infinity when none limits it.
+template <class Model>
+double element_step_limit(const Model& model, const Workspace<Model>& ws) {
+  double limit = std::numeric_limits<double>::infinity();
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
+    if constexpr (LimitsSteps<E>) {
+      const auto& states = std::get<type>(ws.states);
+      for (std::size_t i = 0; i < pool.size(); ++i)
+        limit = std::min(limit,
+                         pool[i].step_limit(detail::input_of(pool[i], ws.frames, ws.t), states[i]));
+    }
+  });
+  return limit;
+}
+
+/// Stateful elements start from the current frames.
 template <class Model>
 void initialize_states(const Model& model, Workspace<Model>& ws) {
   model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto type) {
-    if constexpr (StatefulForce<E>) {
+    if constexpr (Stateful<E>) {
       auto& states = std::get<type>(ws.states);
       for (std::size_t i = 0; i < pool.size(); ++i)
         states[i] = pool[i].initial_state(detail::input_of(pool[i], ws.frames, ws.t));

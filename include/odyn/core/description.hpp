@@ -52,11 +52,17 @@ struct ParameterKind {
 };
 
 /// Every kind a description may use. A vector's, a wrench's or a matrix's default 0 is zero.
-inline constexpr std::array<ParameterKind, 21> parameter_kinds{{
+inline constexpr std::array<ParameterKind, 23> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
     {"joint", "the name of a joint added before"},
+    {"turning_joint",
+     "the name of a revolute or cylindrical joint added before (in the plane: a revolute joint), "
+     "whose angle the element takes"},
+    {"sliding_joint",
+     "the name of a translational or cylindrical joint added before (in the plane: a "
+     "translational joint), whose slide the element takes"},
     {"vector", "3 numbers in space, 2 in the plane"},
     {"frame",
      "a joint frame on a body, in body coordinates: {point, axis, reference} in space (left out: "

@@ -53,15 +53,36 @@ concept NamedElement = requires(const E& e) {
   { e.bodies() } -> std::same_as<const std::array<BodyId, E::num_bodies>&>;
 };
 
-/// A kinematic constraint: joints and drivers.
+/// A kinematic constraint that needs no memory of the past: joints and drivers.
 template <class E>
-concept Constraint = NamedElement<E> &&
+concept StatelessConstraint =
+    NamedElement<E> &&
     requires(const E& e, const InputOf<E>& in,
              ConstraintBlocks<typename E::Space, E::num_equations, E::num_bodies>& out) {
-  { E::num_equations } -> std::convertible_to<int>;
-  e.evaluate(in, out);
-  { e.gamma(in) } -> std::convertible_to<Eigen::Matrix<double, E::num_equations, 1>>;
-};
+      { E::num_equations } -> std::convertible_to<int>;
+      e.evaluate(in, out);
+      { e.gamma(in) } -> std::convertible_to<Eigen::Matrix<double, E::num_equations, 1>>;
+    };
+
+/// A constraint with a discrete state, kept and advanced as a stateful force's is: a gear pair
+/// between two spatial hinges, whose equation needs each angle's whole turns.
+template <class E>
+concept StatefulConstraint =
+    NamedElement<E> &&
+    requires(const E& e, const InputOf<E>& in, typename E::State& state,
+             ConstraintBlocks<typename E::Space, E::num_equations, E::num_bodies>& out) {
+      { E::num_equations } -> std::convertible_to<int>;
+      { e.initial_state(in) } -> std::same_as<typename E::State>;
+      e.evaluate(in, std::as_const(state), out);
+      {
+        e.gamma(in, std::as_const(state))
+      } -> std::convertible_to<Eigen::Matrix<double, E::num_equations, 1>>;
+      e.advance(in, state);
+    };
+
+/// A kinematic constraint: joints, drivers and couplings.
+template <class E>
+concept Constraint = StatelessConstraint<E> || StatefulConstraint<E>;
 
 template <class E>
 using BlocksOf = ConstraintBlocks<typename E::Space, E::num_equations, E::num_bodies>;
@@ -88,6 +109,10 @@ concept StatefulForce = NamedElement<E> &&
 
 template <class E>
 concept ForceElement = StatelessForce<E> || StatefulForce<E>;
+
+/// An element, force or constraint, whose discrete state the workspace keeps.
+template <class E>
+concept Stateful = StatefulForce<E> || StatefulConstraint<E>;
 
 /// Optional: a stateful force whose law switches abruptly (a valve opening, a contact closing).
 /// event_function(in, state) is negative before the next switch and reaches zero at it. The
@@ -142,6 +167,15 @@ concept HasGeometricStiffness = Constraint<E> &&
   e.add_geometric_stiffness(in, lambda, out);
 };
 
+/// Optional: a stateful element that limits the next step from its state (an angle that counts
+/// whole turns from the last accepted one must turn by less than half a turn in a step). The
+/// integrators take no longer step than the smallest limit; without it, there is none.
+template <class E>
+concept LimitsSteps =
+    Stateful<E> && requires(const E& e, const InputOf<E>& in, const typename E::State& s) {
+      { e.step_limit(in, s) } -> std::convertible_to<double>;
+    };
+
 /// Optional: a force element with a potential energy.
 template <class E>
 concept HasPotential = requires(const E& e, const InputOf<E>& in) {
@@ -163,13 +197,13 @@ concept BindsToInitialPose = requires(E& e, const InputOf<E>& in) {
   e.bind(in);
 };
 
-/// The discrete state of a force element type, or an empty placeholder.
+/// The discrete state of an element type, or an empty placeholder.
 template <class E>
 struct StateOfImpl {
   struct None {};
   using type = None;
 };
-template <StatefulForce E>
+template <Stateful E>
 struct StateOfImpl<E> {
   using type = typename E::State;
 };
@@ -185,6 +219,26 @@ void force_jacobians(const E& e, const InputOf<E>& in, const StateOf<E>& state,
     e.jacobians(in, state, out);
   else
     e.jacobians(in, out);
+}
+
+/// A constraint's Phi, Jacobian blocks and Phi_t, with its state if it has one.
+template <Constraint E>
+void evaluate_constraint(const E& e, const InputOf<E>& in, const StateOf<E>& state,
+                         BlocksOf<E>& out) {
+  if constexpr (StatefulConstraint<E>)
+    e.evaluate(in, state, out);
+  else
+    e.evaluate(in, out);
+}
+
+/// A constraint's acceleration right-hand side, with its state if it has one.
+template <Constraint E>
+Eigen::Matrix<double, E::num_equations, 1> constraint_gamma(const E& e, const InputOf<E>& in,
+                                                            const StateOf<E>& state) {
+  if constexpr (StatefulConstraint<E>)
+    return e.gamma(in, state);
+  else
+    return e.gamma(in);
 }
 
 }  // namespace odyn

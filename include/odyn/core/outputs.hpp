@@ -26,7 +26,7 @@ concept HasStatelessOutputs = Described<E> && requires(const E& e, const InputOf
 
 template <class E>
 concept HasStatefulOutputs =
-    Described<E> && StatefulForce<E> &&
+    Described<E> && Stateful<E> &&
     requires(const E& e, const InputOf<E>& in, const typename E::State& state) {
       { e.outputs(in, state) } -> std::same_as<std::array<double, num_outputs<E>>>;
     };

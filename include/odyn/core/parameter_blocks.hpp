@@ -35,6 +35,19 @@ inline constexpr std::array<Parameter, 6> distance =
          std::array<Parameter, 1>{{{"length", "number", "0", "m",
                                     "the distance kept; <= 0: the distance at the initial pose"}}});
 
+/// An existing joint, or two bodies and their frames: what an element on a joint's coordinates
+/// takes (a front end resolves `joint` into the bodies and frames).
+inline constexpr std::array<Parameter, 6> joint_or_frame_pair{{
+    {"name", "name", nullptr, "", "the element's name"},
+    {"joint", "joint", "null", "",
+     "the joint whose coordinates the element takes (its bodies and frames are taken); or give "
+     "body_a and body_b"},
+    {"body_a", "body", "null", "", "the first body (without joint)"},
+    {"on_a", "frame", "null", "m", "the joint's frame on body a (without joint)"},
+    {"body_b", "body", "null", "", "the second body (without joint)"},
+    {"on_b", "frame", "null", "m", "the joint's frame on body b (without joint)"},
+}};
+
 /// A driver: an existing joint, or two bodies and their frames; and the motion.
 inline constexpr std::array<Parameter, 7> driver{{
     {"name", "name", nullptr, "", "the element's name"},
@@ -53,6 +66,7 @@ inline constexpr std::array<const char*, 1> revolute_joints{"revolute"};
 inline constexpr std::array<const char*, 2> turning_joints{"revolute", "cylindrical"};
 inline constexpr std::array<const char*, 1> translational_joints{"translational"};
 inline constexpr std::array<const char*, 2> sliding_joints{"translational", "cylindrical"};
+inline constexpr std::array<const char*, 1> cylindrical_joints{"cylindrical"};
 
 /// A rotational spring-damper-actuator's law.
 inline constexpr std::array<Parameter, 4> rotational_spring{{
@@ -70,6 +84,24 @@ inline constexpr std::array<Parameter, 4> translational_spring{{
     {"free_length", "nonnegative", "0", "m", "the length at which the spring exerts no force"},
     {"actuator", "optional_callable", "null", "N", "actuator(t, L, L') -> extra tension"},
 }};
+
+/// A joint's bodies and frames, as a front end passes a turning_joint or sliding_joint
+/// parameter (the name of a joint added before, resolved).
+template <class Frame>
+struct JointReference {
+  BodyId body_a;
+  Frame on_a;
+  BodyId body_b;
+  Frame on_b;
+};
+
+/// The pair joint (Pair: the space's two-body joint base) that parameter `key` names, under the
+/// element's `name` (so that its frames' errors name the element).
+template <class Pair, class Frame, class Reader>
+Pair pair_joint(Reader& r, const char* key, const std::string& name) {
+  const auto joint = parameter<JointReference<Frame>>(r, key);
+  return Pair(name, joint.body_a, joint.on_a, joint.body_b, joint.on_b);
+}
 
 /// Joint(name, body_a, on_a, body_b, on_b, rest...) from the parameters of frame_pair; Frame is
 /// the space's joint frame type.

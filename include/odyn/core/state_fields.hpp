@@ -18,9 +18,9 @@ namespace odyn {
 template <Described E>
 inline constexpr std::size_t num_state_fields = E::description.state_fields.size();
 
-/// Optional: a stateful force whose state results record.
+/// Optional: a stateful element whose state results record.
 template <class E>
-concept RecordsState = Described<E> && StatefulForce<E> && num_state_fields<E> > 0 &&
+concept RecordsState = Described<E> && Stateful<E> && num_state_fields<E> > 0 &&
                        requires(const typename E::State& state) {
                          {
                            E::state_values(state)

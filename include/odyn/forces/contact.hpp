@@ -22,6 +22,7 @@
 #include "odyn/core/description.hpp"
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
+#include "odyn/forces/hunt_crossley.hpp"
 
 namespace odyn {
 
@@ -33,14 +34,14 @@ struct ContactLaw {
   double friction = 0.0;     // mu
   double slip_speed = 1e-3;  // v_s, m/s: the slip at which friction reaches tanh(1) mu F_n
 
+  /// The normal law.
+  HuntCrossley normal_law() const { return {stiffness, exponent, dissipation}; }
   /// The normal force at penetration `depth` (> 0) and its rate.
   double normal_force(double depth, double rate) const {
-    return std::max(0.0, stiffness * std::pow(depth, exponent) * (1.0 + dissipation * rate));
+    return normal_law().at(depth, rate).force;
   }
   /// The elastic energy stored at penetration `depth` (> 0).
-  double energy(double depth) const {
-    return stiffness * std::pow(depth, exponent + 1.0) / (exponent + 1.0);
-  }
+  double energy(double depth) const { return normal_law().energy(depth); }
   /// mu tanh(s / v_s) / s: the friction force per unit normal force and unit slip velocity.
   double friction_per_slip(double slip) const {
     if (friction == 0.0) return 0.0;
@@ -208,12 +209,7 @@ class ContactT {
         throw ModelError(
             name_, std::string(what) + " is " + to_text(value) + "; it must be zero or positive");
     };
-    positive(law_.stiffness, "stiffness");
-    if (!(law_.exponent >= 1.0) || !std::isfinite(law_.exponent))
-      throw ModelError(name_, "exponent is " + to_text(law_.exponent) +
-                                  "; it must be 1 or more (below 1 the stiffness is infinite "
-                                  "at first touch)");
-    nonnegative(law_.dissipation, "dissipation");
+    law_.normal_law().check(name_);
     nonnegative(law_.friction, "friction");
     positive(law_.slip_speed, "slip_speed");
     if (bodies_[0] == bodies_[1])
@@ -248,11 +244,8 @@ class ContactT {
     const Touch c = touch(in);
     if (c.gap >= 0.0) return;
     const double depth = -c.gap, rate = -c.gap_rate;
-    const double normal = law_.normal_force(depth, rate);
+    const auto [normal, stiffness, damping] = law_.normal_law().at(depth, rate);
     if (normal <= 0.0) return;  // separating faster than the law pushes: no force near here
-    // dF_n/d(delta) = n k delta^(n-1) (1 + d delta'), dF_n/d(delta') = k delta^n d.
-    const double stiffness = law_.exponent * normal / depth;
-    const double damping = law_.stiffness * std::pow(depth, law_.exponent) * law_.dissipation;
     const double per_slip = law_.friction_per_slip(c.slip.norm());
     // The force on b per unit normal force, friction included: F = F_n (n - phi v_t).
     const Vector per_normal = c.normal - per_slip * c.slip;

@@ -23,6 +23,8 @@
 #include "odyn/core/element.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/joint_coordinate.hpp"
+#include "odyn/core/parameter_blocks.hpp"
+#include "odyn/forces/hunt_crossley.hpp"
 
 namespace odyn {
 
@@ -53,22 +55,18 @@ struct LimitLaw {
     return {0.0, 0.0};
   }
 
+  /// The stops' law on the penetration.
+  HuntCrossley push_law() const { return {stiffness, exponent, dissipation}; }
+
   Response at(double x, double rate) const {
     const auto [depth, side] = penetration(x);
-    if (depth <= 0.0) return {};
-    const double depth_rate = side * -rate;  // d(delta)/dt
-    const double elastic = stiffness * std::pow(depth, exponent);
-    const double push = elastic * (1.0 + dissipation * depth_rate);
-    if (push <= 0.0) return {};  // leaving faster than the law pushes: no pull
+    const HuntCrossley::Push push = push_law().at(depth, side * -rate);
     // dF/dx = side * dF_n/d(delta) * d(delta)/dx = -dF_n/d(delta): the same on both sides.
-    return {side * push, exponent * push / depth, elastic * dissipation};
+    return {side * push.force, push.stiffness, push.damping};
   }
 
   /// The elastic energy stored at `x`.
-  double energy(double x) const {
-    const double depth = penetration(x).first;
-    return depth > 0.0 ? stiffness * std::pow(depth, exponent + 1.0) / (exponent + 1.0) : 0.0;
-  }
+  double energy(double x) const { return push_law().energy(penetration(x).first); }
 
   /// Refuses limits or a law that cannot work, naming the element.
   void check(const std::string& name) const {
@@ -79,15 +77,7 @@ struct LimitLaw {
     if (lower && upper && !(*lower < *upper))
       throw ModelError(name, "lower is " + to_text(*lower) + " and upper " + to_text(*upper) +
                                  "; lower must be below upper");
-    if (!(stiffness > 0.0) || !std::isfinite(stiffness))
-      throw ModelError(name, "stiffness is " + to_text(stiffness) + "; it must be positive");
-    if (!(exponent >= 1.0) || !std::isfinite(exponent))
-      throw ModelError(name, "exponent is " + to_text(exponent) +
-                                 "; it must be 1 or more (below 1 the stiffness is infinite at "
-                                 "first touch)");
-    if (!(dissipation >= 0.0) || !std::isfinite(dissipation))
-      throw ModelError(name,
-                       "dissipation is " + to_text(dissipation) + "; it must be zero or positive");
+    push_law().check(name);
   }
 
   template <class Reader>
@@ -99,18 +89,6 @@ struct LimitLaw {
 };
 
 namespace parameters {
-
-/// An existing joint, or two bodies and their frames: where a limit acts.
-inline constexpr std::array<Parameter, 6> joint_or_frame_pair{{
-    {"name", "name", nullptr, "", "the element's name"},
-    {"joint", "joint", "null", "",
-     "the joint whose coordinate is limited (its bodies and frames are taken); or give body_a "
-     "and body_b"},
-    {"body_a", "body", "null", "", "the first body (without joint)"},
-    {"on_a", "frame", "null", "m", "the joint's frame on body a (without joint)"},
-    {"body_b", "body", "null", "", "the second body (without joint)"},
-    {"on_b", "frame", "null", "m", "the joint's frame on body b (without joint)"},
-}};
 
 /// A limit's law, on an angle (`angular`) or a slide.
 inline constexpr std::array<Parameter, 5> limit_law(bool angular) {

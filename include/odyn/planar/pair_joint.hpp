@@ -39,6 +39,8 @@ class PairJoint {
   using Vector = Eigen::Vector2d;
   static constexpr int num_bodies = 2;
   using Input = ElementInput<Space, 2>;
+  /// The joint angle counts whole turns by itself (a difference of body angles).
+  static constexpr bool angle_counts_turns_by_state = false;
 
   /// A joint's frame on one body, normalized.
   struct Side {
@@ -81,6 +83,22 @@ class PairJoint {
     x.value = row.phi[0];
     x.direction << row.jacobian[0].transpose(), row.jacobian[1].transpose();
     x.set_rate(in);
+    return x;
+  }
+
+  /// The slide as a constraint row.
+  JointRow<Space> slide_row(const Input& in) const {
+    const JointCoordinate<Space> slid = slide(in);
+    return {slid.value,
+            primitive::on_line_gamma(in.body(0), on_a_.axis, on_a_.point, in.body(1), on_b_.point),
+            slid.direction};
+  }
+
+  /// The joint angle as a constraint row (it counts turns by itself: `near` is not needed).
+  JointRow<Space> angle_row(const Input& in, double /*near*/) const {
+    JointRow<Space> x;
+    x.value = angle(in);
+    x.gradient << 0.0, 0.0, -1.0, 0.0, 0.0, 1.0;
     return x;
   }
 

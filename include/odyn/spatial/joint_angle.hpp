@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "odyn/core/description.hpp"
+#include "odyn/core/joint_coordinate.hpp"
 #include "odyn/spatial/pair_joint.hpp"
 
 namespace odyn::spatial {
@@ -40,6 +41,9 @@ class JointAngle : public PairJoint {
   }
 
   double rate(const Input& in) const { return direction(in).dot(velocities(in)); }
+
+  /// Each step must turn the angle by less than half a turn (see turn_step_limit).
+  double step_limit(const Input& in, const State&) const { return turn_step_limit(rate(in)); }
 
  protected:
   /// The angle within (-pi, pi].

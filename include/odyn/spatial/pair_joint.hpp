@@ -2,6 +2,8 @@
 // What every two-body spatial joint shares: its name, its bodies and its frame on each body.
 
 #include <array>
+#include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 
@@ -20,6 +22,8 @@ class PairJoint {
   using Space = odyn::Spatial;
   static constexpr int num_bodies = 2;
   using Input = ElementInput<Space, 2>;
+  /// The angle about a's axis counts whole turns only from a state (see angle_row).
+  static constexpr bool angle_counts_turns_by_state = true;
 
   PairJoint(std::string name, BodyId body_a, const JointFrame& on_a, BodyId body_b,
             const JointFrame& on_b)
@@ -50,6 +54,39 @@ class PairJoint {
     x.direction << row.jacobian[0].transpose(), row.jacobian[1].transpose();
     x.set_rate(in);
     return x;
+  }
+
+  /// The slide as a constraint row.
+  JointRow<Space> slide_row(const Input& in) const {
+    const JointCoordinate<Space> slid = slide(in);
+    return {slid.value,
+            primitive::dot2_gamma(in.body(0), on_a_.w, on_a_.point, in.body(1), on_b_.point),
+            slid.direction};
+  }
+
+  /// The angle of b's reference u about a's axis w, from a's reference u, as a constraint row:
+  /// atan2(v_a . u_b, u_a . u_b), whole turns added to come nearest `near`. Its gradient and
+  /// gamma are the exact derivatives of that atan2, so that Newton and the acceleration level
+  /// agree with it even off the joint's own equations.
+  JointRow<Space> angle_row(const Input& in, double near) const {
+    const auto &a = in.body(0), &b = in.body(1);
+    ConstraintBlocks<Space, 2, 2> rows;  // y = v_a . u_b, then x = u_a . u_b
+    primitive::dot1(a, on_a_.v, b, on_b_.u, rows, 0);
+    primitive::dot1(a, on_a_.u, b, on_b_.u, rows, 1);
+    const double y = rows.phi[0], x = rows.phi[1], r2 = x * x + y * y;
+    const double y_rate = primitive::dot1_rate(a, on_a_.v, b, on_b_.u);
+    const double x_rate = primitive::dot1_rate(a, on_a_.u, b, on_b_.u);
+    const double y_gamma = primitive::dot1_gamma(a, on_a_.v, b, on_b_.u);
+    const double x_gamma = primitive::dot1_gamma(a, on_a_.u, b, on_b_.u);
+    JointRow<Space> angle;
+    const double turn = 2.0 * std::numbers::pi, raw = std::atan2(y, x);
+    angle.value = raw + turn * std::round((near - raw) / turn);
+    for (int k = 0; k < 2; ++k)
+      angle.gradient.segment<Space::nv>(k * Space::nv) =
+          ((x * rows.jacobian[k].row(0) - y * rows.jacobian[k].row(1)) / r2).transpose();
+    const double cross = x * y_rate - y * x_rate, along = x * x_rate + y * y_rate;
+    angle.gamma = (x * y_gamma - y * x_gamma) / r2 + 2.0 * cross * along / (r2 * r2);
+    return angle;
   }
 
   /// Completes the reference directions from the initial pose (see JointFrame::reference).

@@ -1,0 +1,326 @@
+// Gears, rack and pinion, and screw (core/joint_coupling.hpp, core/gear_pairs.hpp,
+// spatial/screw_joint.hpp) against independent references:
+// - the coupling's Jacobian blocks and gamma against central differences of its Phi, at poses
+//   where the joints' own equations do not hold (so that the exact atan2 derivatives are
+//   tested, not their on-joint shortcut), and its angle counting the state's whole turns;
+// - a torque-driven gear pair turns as one rigid inertia I_a + ratio^2 I_b, for many turns and
+//   a ratio that is not an integer, in space and in the plane, in absolute and joint
+//   coordinates, with dop853 and generalized-alpha;
+// - a pushed rack drives its pinion at s = r theta with (m + I / r^2) s'' = F;
+// - a nut on a vertical lead screw sinks under gravity at g m / (m + I (2 pi / p)^2);
+// - zero ratios, radii and pitches are refused by name.
+
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include <odyn/odyn.hpp>
+
+namespace test_gears {
+
+namespace sp = odyn::spatial;
+namespace pl = odyn::planar;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using Space = odyn::Spatial;
+constexpr double pi = std::numbers::pi;
+
+// Deterministic numbers in [-1, 1) (std::mt19937's output is fixed by the standard).
+struct Random {
+  std::mt19937 engine{20261129u};
+  double uniform() { return 2.0 * (static_cast<double>(engine()) / 4294967296.0) - 1.0; }
+  Vector3d vector(double scale) { return scale * Vector3d(uniform(), uniform(), uniform()); }
+};
+
+/// Bodies 1..3 at random poses and velocities (body 0: the ground).
+struct Poses {
+  std::array<Space::Configuration, 4> q;
+  std::array<Space::Velocity, 4> v;
+  std::array<Space::Frame, 4> frames;
+  explicit Poses(Random& random) {
+    q[0] << 0, 0, 0, 1, 0, 0, 0;
+    v[0].setZero();
+    for (int b = 1; b < 4; ++b) {
+      Eigen::Quaterniond r(random.uniform(), random.uniform(), random.uniform(), random.uniform());
+      r.normalize();
+      q[b] << random.vector(0.5), r.w(), r.x(), r.y(), r.z();
+      v[b] << random.vector(1.0), random.vector(2.0);
+    }
+    update();
+  }
+  void update() {
+    for (int b = 0; b < 4; ++b) Space::make_frame(q[b], v[b], frames[b]);
+  }
+  /// Every body moved along its velocity for dt (body-frame rates constant).
+  Poses drifted(double dt) const {
+    Poses out = *this;
+    for (int b = 1; b < 4; ++b) Space::integrate(q[b], dt * v[b], out.q[b]);
+    out.update();
+    return out;
+  }
+};
+
+template <class E>
+odyn::InputOf<E> input_of(const E& e, const Poses& p) {
+  odyn::InputOf<E> in;
+  for (int k = 0; k < E::num_bodies; ++k) in.frames[k] = &p.frames[e.bodies()[k].index];
+  return in;
+}
+
+/// Phi, its Jacobian blocks and gamma of a coupling against central differences.
+template <class E>
+void check_blocks(E element, Poses poses) {
+  element.bind(input_of(element, poses));
+  // Off the joints, then: the bodies move on from the pose the coupling was bound at.
+  poses = poses.drifted(0.3);
+  const auto state = element.initial_state(input_of(element, poses));
+  const auto phi_at = [&](const Poses& p) {
+    odyn::BlocksOf<E> blocks;
+    element.evaluate(input_of(element, p), state, blocks);
+    return blocks.phi[0];
+  };
+  odyn::BlocksOf<E> blocks;
+  element.evaluate(input_of(element, poses), state, blocks);
+  const double eps = 1e-6;
+  double rate = 0.0;  // Phi_q v
+  for (int k = 0; k < E::num_bodies; ++k) {
+    const int b = element.bodies()[k].index;
+    if (b == 0) continue;  // the ground, or a body another slot holds already
+    for (int i = 0; i < Space::nv; ++i) {
+      Poses plus = poses, minus = poses;
+      Space::integrate(poses.q[b], eps * Space::Velocity::Unit(i), plus.q[b]);
+      Space::integrate(poses.q[b], -eps * Space::Velocity::Unit(i), minus.q[b]);
+      plus.update();
+      minus.update();
+      const double numeric = (phi_at(plus) - phi_at(minus)) / (2.0 * eps);
+      INFO("body slot " << k << ", coordinate " << i);
+      CHECK(blocks.jacobian[k](0, i) == Approx(numeric).epsilon(1e-6).margin(1e-8));
+    }
+    rate += blocks.jacobian[k].row(0).dot(poses.v[b]);
+  }
+  CHECK(blocks.phi_t[0] == 0.0);
+  // gamma: with v' = 0 in body coordinates, d/dt (Phi_q v) = -gamma.
+  const auto rate_at = [&](const Poses& p) {
+    odyn::BlocksOf<E> at;
+    element.evaluate(input_of(element, p), state, at);
+    double sum = 0.0;
+    for (int k = 0; k < E::num_bodies; ++k)
+      if (element.bodies()[k].index != 0)
+        sum += at.jacobian[k].row(0).dot(p.v[element.bodies()[k].index]);
+    return sum;
+  };
+  const double dt = 1e-5;
+  const double numeric_gamma =
+      -(rate_at(poses.drifted(dt)) - rate_at(poses.drifted(-dt))) / (2 * dt);
+  const double gamma = element.gamma(input_of(element, poses), state)[0];
+  CHECK(gamma == Approx(numeric_gamma).epsilon(1e-6).margin(1e-7));
+  CHECK(std::abs(gamma) > 1e-2);  // the velocity terms are not all zero: a meaningful check
+  // Phi's rate along the motion.
+  const double numeric_rate =
+      (phi_at(poses.drifted(eps)) - phi_at(poses.drifted(-eps))) / (2 * eps);
+  CHECK(rate == Approx(numeric_rate).epsilon(1e-6).margin(1e-8));
+  // The angles count whole turns from the state's.
+  auto turned = state;
+  for (double& angle : turned.angle) angle += 6.0 * pi;
+  odyn::BlocksOf<E> later;
+  element.evaluate(input_of(element, poses), turned, later);
+  double expected = 0.0;
+  for (int i = 0; i < 2; ++i)
+    if (element.term(i).kind == odyn::JointCoordinateKind::angle)
+      expected += element.term(i).coefficient * 6.0 * pi;
+  CHECK(later.phi[0] - blocks.phi[0] == Approx(expected).margin(1e-9));
+}
+
+TEST_CASE("Couplings' Jacobians and gamma are their Phi's derivatives", "[gears]") {
+  Random random;
+  const Poses poses(random);
+  const auto frame = [&] {
+    return sp::JointFrame{random.vector(0.3), random.vector(1.0), random.vector(1.0)};
+  };
+  SECTION("a gear between two hinges on a common carrier") {
+    const sp::Revolute a("a", odyn::BodyId{1}, frame(), odyn::BodyId{2}, frame());
+    const sp::Revolute b("b", odyn::BodyId{1}, frame(), odyn::BodyId{3}, frame());
+    const sp::Gear gear("mesh", a, b, -0.37);
+    CHECK(gear.bodies()[2].is_ground());  // the carrier takes one slot
+    check_blocks(gear, poses);
+  }
+  SECTION("a rack and pinion on different bodies") {
+    const sp::Revolute pinion("pinion", odyn::BodyId{1}, frame(), odyn::BodyId{2}, frame());
+    const sp::Translational rack("rack", odyn::ground, frame(), odyn::BodyId{3}, frame());
+    check_blocks(sp::RackPinion("drive", pinion, rack, 0.05), poses);
+  }
+  SECTION("a screw") {
+    check_blocks(sp::ScrewJoint("lead", odyn::BodyId{2}, frame(), odyn::BodyId{3}, frame(), 0.004),
+                 poses);
+  }
+}
+
+odyn::DynamicsSettings settings_for(const std::string& integrator, const std::string& coordinates,
+                                    double t_end) {
+  odyn::DynamicsSettings s;
+  s.integrator = integrator;
+  s.coordinates = coordinates;
+  s.t_end = t_end;
+  s.output_interval = t_end;
+  s.rtol = 1e-11;
+  s.atol = 1e-13;
+  s.step = 1e-3;
+  return s;
+}
+
+TEST_CASE("A gear pair turns as one inertia, for many turns", "[gears]") {
+  // theta_a'' = T / (I_a + ratio^2 I_b); over 2 s gear a turns 6.4 times, gear b 4.4 times.
+  const double torque = 2.0, inertia_a = 0.1, inertia_b = 0.3, ratio = -0.69, t_end = 2.0;
+  const double accel = torque / (inertia_a + ratio * ratio * inertia_b);
+  const double angle_a = 0.5 * accel * t_end * t_end;
+  for (const char* integrator : {"dop853", "generalized-alpha"}) {
+    for (const char* coordinates : {"absolute", "joint"}) {
+      const odyn::DynamicsSettings s = settings_for(integrator, coordinates, t_end);
+      // generalized-alpha's error in the angle, second order in h = 1e-3: about 1e-6 rad.
+      const double tolerance = s.integrator == "dop853" ? 1e-8 : 1e-5;
+      SECTION(std::string("in space, ") + integrator + ", " + coordinates) {
+        sp::DefaultModel model;
+        const Vector3d axis_a = Vector3d(0.0, 0.6, 0.8), axis_b = Vector3d(1.0, 2.0, 2.0) / 3.0;
+        const auto disk = [](const char* name, double i) {
+          return sp::Body{.name = name, .mass = 1.0, .inertia = sp::Body::principal(i, i, i)};
+        };
+        const auto a = model.add_body(disk("a", inertia_a));
+        auto body_b = disk("b", inertia_b);
+        body_b.position = Vector3d(0.3, 0.0, 0.0);
+        const auto b = model.add_body(body_b);
+        const sp::Revolute hinge_a("hinge_a", odyn::ground, {Vector3d::Zero(), axis_a}, a,
+                                   {Vector3d::Zero(), axis_a});
+        const sp::Revolute hinge_b("hinge_b", odyn::ground, {Vector3d(0.3, 0.0, 0.0), axis_b}, b,
+                                   {Vector3d::Zero(), axis_b});
+        model.add(hinge_a);
+        model.add(hinge_b);
+        model.add(sp::Gear("mesh", hinge_a, hinge_b, ratio));
+        model.add(sp::PointTorque("motor", a, Vector3d(torque * axis_a)));
+        odyn::Workspace<sp::DefaultModel> ws(model);
+        odyn::simulate(model, ws, s, [](const auto&) {});
+        const auto turn_error = [&](int body, const Vector3d& axis, double angle) {
+          const Eigen::Matrix3d expected = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+          return (ws.frames[body].rotation - expected).norm();
+        };
+        CHECK(turn_error(1, axis_a, angle_a) < tolerance * angle_a);
+        CHECK(turn_error(2, axis_b, ratio * angle_a) < tolerance * angle_a);
+        const Vector3d omega_b = ws.frames[2].rotation * ws.frames[2].angular_velocity;
+        CHECK((omega_b - ratio * accel * t_end * axis_b).norm() < tolerance * accel * t_end);
+      }
+      SECTION(std::string("in the plane, ") + integrator + ", " + coordinates) {
+        pl::DefaultModel model;
+        const auto a = model.add_body(pl::Body{.name = "a", .mass = 1.0, .inertia = inertia_a});
+        const auto b = model.add_body(
+            pl::Body{.name = "b", .mass = 1.0, .inertia = inertia_b, .position = {0.3, 0.0}});
+        const pl::Revolute hinge_a("hinge_a", odyn::ground, {}, a, {});
+        const pl::Revolute hinge_b("hinge_b", odyn::ground, {Vector2d(0.3, 0.0), {}}, b, {});
+        model.add(hinge_a);
+        model.add(hinge_b);
+        model.add(pl::Gear("mesh", hinge_a, hinge_b, ratio));
+        model.add(pl::PointTorque("motor", a, torque));
+        odyn::Workspace<pl::DefaultModel> ws(model);
+        odyn::simulate(model, ws, s, [](const auto&) {});
+        CHECK(std::abs(ws.frames[1].angle - angle_a) < tolerance * angle_a);
+        CHECK(std::abs(ws.frames[2].angle - ratio * angle_a) < tolerance * angle_a);
+      }
+    }
+  }
+}
+
+TEST_CASE("A pushed rack drives its pinion", "[gears]") {
+  // (m + I / r^2) s'' = F, theta = s / r.
+  const double mass = 2.0, inertia = 0.01, radius = 0.05, force = 3.0, t_end = 1.0;
+  const double accel = force / (mass + inertia / (radius * radius));
+  const double slide = 0.5 * accel * t_end * t_end;
+  for (const char* coordinates : {"absolute", "joint"}) {
+    const odyn::DynamicsSettings s = settings_for("dop853", coordinates, t_end);
+    SECTION(std::string("in space, ") + coordinates) {
+      sp::DefaultModel model;
+      const auto pinion = model.add_body(sp::Body{
+          .name = "pinion", .mass = 0.5, .inertia = sp::Body::principal(0.2, 0.2, inertia)});
+      auto rack_body =
+          sp::Body{.name = "rack", .mass = mass, .inertia = sp::Body::principal(1, 1, 1)};
+      rack_body.position = Vector3d(0.0, -radius, 0.0);
+      const auto rack = model.add_body(rack_body);
+      const sp::Revolute hinge("hinge", odyn::ground, {}, pinion, {});
+      const sp::Translational guide("guide", odyn::ground,
+                                    {Vector3d(0, -radius, 0), Vector3d::UnitX()}, rack,
+                                    {Vector3d::Zero(), Vector3d::UnitX()});
+      model.add(hinge);
+      model.add(guide);
+      model.add(sp::RackPinion("drive", hinge, guide, -radius));
+      model.add(sp::PointForce("push", rack, Vector3d::Zero(), Vector3d(force, 0.0, 0.0)));
+      odyn::Workspace<sp::DefaultModel> ws(model);
+      odyn::simulate(model, ws, s, [](const auto&) {});
+      CHECK(ws.frames[2].position.x() == Approx(slide).epsilon(1e-9));
+      const Eigen::Matrix3d expected =
+          Eigen::AngleAxisd(-slide / radius, Vector3d::UnitZ()).toRotationMatrix();
+      CHECK((ws.frames[1].rotation - expected).norm() < 1e-8);
+    }
+    SECTION(std::string("in the plane, ") + coordinates) {
+      pl::DefaultModel model;
+      const auto pinion =
+          model.add_body(pl::Body{.name = "pinion", .mass = 0.5, .inertia = inertia});
+      const auto rack = model.add_body(
+          pl::Body{.name = "rack", .mass = mass, .inertia = 1.0, .position = {0.0, -radius}});
+      const pl::Revolute hinge("hinge", odyn::ground, {}, pinion, {});
+      const pl::Translational guide("guide", odyn::ground,
+                                    {Vector2d(0, -radius), Vector2d::UnitX()}, rack,
+                                    {Vector2d::Zero(), Vector2d::UnitX()});
+      model.add(hinge);
+      model.add(guide);
+      model.add(pl::RackPinion("drive", hinge, guide, -radius));
+      model.add(pl::PointForce("push", rack, Vector2d::Zero(), Vector2d(force, 0.0)));
+      odyn::Workspace<pl::DefaultModel> ws(model);
+      odyn::simulate(model, ws, s, [](const auto&) {});
+      CHECK(ws.frames[2].position.x() == Approx(slide).epsilon(1e-9));
+      CHECK(ws.frames[1].angle == Approx(-slide / radius).epsilon(1e-9));
+    }
+  }
+}
+
+TEST_CASE("A nut sinks down a lead screw", "[gears]") {
+  // s'' = -g m / (m + I (2 pi / p)^2), theta = 2 pi s / p.
+  const double mass = 0.4, inertia = 2e-5, pitch = 0.01, g = 9.81, t_end = 0.5;
+  const double lead = 2.0 * pi / pitch;
+  const double accel = -g * mass / (mass + inertia * lead * lead);
+  const double slide = 0.5 * accel * t_end * t_end;
+  for (const char* integrator : {"dop853", "bdf"}) {
+    for (const char* coordinates : {"absolute", "joint"}) {
+      DYNAMIC_SECTION(integrator << ", " << coordinates) {
+        sp::DefaultModel model;
+        const auto nut = model.add_body(sp::Body{
+            .name = "nut", .mass = mass, .inertia = sp::Body::principal(1e-5, 1e-5, inertia)});
+        const sp::Cylindrical shaft("shaft", odyn::ground, {}, nut, {});
+        model.add(shaft);
+        model.add(sp::ScrewJoint("thread", shaft, pitch));
+        model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
+        odyn::Workspace<sp::DefaultModel> ws(model);
+        odyn::simulate(model, ws, settings_for(integrator, coordinates, t_end), [](const auto&) {});
+        const double tolerance = std::string(integrator) == "dop853" ? 1e-9 : 1e-5;
+        CHECK(ws.frames[1].position.z() == Approx(slide).epsilon(tolerance));
+        const Eigen::Matrix3d expected =
+            Eigen::AngleAxisd(lead * slide, Vector3d::UnitZ()).toRotationMatrix();
+        CHECK((ws.frames[1].rotation - expected).norm() < tolerance * std::abs(lead * slide));
+      }
+    }
+  }
+}
+
+TEST_CASE("Zero ratios, radii and pitches are refused by name", "[gears]") {
+  const sp::Revolute a("a", odyn::ground, {}, odyn::BodyId{1}, {});
+  const sp::Translational t("t", odyn::ground, {}, odyn::BodyId{2}, {});
+  const sp::Cylindrical c("c", odyn::ground, {}, odyn::BodyId{1}, {});
+  CHECK_THROWS_WITH(sp::Gear("mesh", a, a, 0.0),
+                    Catch::Contains("mesh") && Catch::Contains("ratio is 0"));
+  CHECK_THROWS_WITH(sp::RackPinion("drive", a, t, std::nan("")),
+                    Catch::Contains("drive") && Catch::Contains("radius is nan"));
+  CHECK_THROWS_WITH(sp::ScrewJoint("lead", c, 0.0),
+                    Catch::Contains("lead") && Catch::Contains("pitch is 0"));
+}
+
+}  // namespace test_gears
