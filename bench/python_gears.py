@@ -16,7 +16,7 @@ For each: the relative error, the steps and the median wall time of 5 runs.
 import math
 
 import odyn
-from speed_error_table import print_table
+from speed_error_table import COMMON_CASES, print_table
 
 G = 9.81
 TORQUE, J_PINION, J_WHEEL, RATIO = 0.2, 1e-3, 0.016, -0.25
@@ -54,11 +54,7 @@ def lead_screw_error(r):
     return abs(r.output("thread", "slide")[-1] / expected - 1.0)
 
 
-CASES = [
-    ("auto (defaults)", {}),
-    ("dop853, rtol = atol = 1e-6", {"integrator": "dop853", "rtol": 1e-6, "atol": 1e-6}),
-    ("dop853, 1e-9", {"integrator": "dop853", "rtol": 1e-9, "atol": 1e-9}),
-    ("bdf, 1e-6", {"integrator": "bdf", "rtol": 1e-6, "atol": 1e-6}),
+CASES = COMMON_CASES + [
     ("generalized-alpha, h = 1e-3 s", {"integrator": "generalized-alpha", "step": 1e-3}),
     ("dop853, 1e-9, joint coordinates",
      {"integrator": "dop853", "rtol": 1e-9, "atol": 1e-9, "coordinates": "joint"}),

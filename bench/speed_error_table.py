@@ -1,11 +1,20 @@
-"""The speed-against-error table that bench/python_contact.py and bench/python_limits.py print:
-for each integrator setting, each problem's relative error against its closed form, its steps
-and the median wall time of 5 runs."""
+"""The speed-against-error table that bench/python_contact.py, python_limits.py and
+python_gears.py print: for each integrator setting, each problem's relative error against its
+closed form, its steps and the median wall time of 5 runs."""
 
 import statistics
 import time
 
 import odyn
+
+
+#: The settings a table starts with: the defaults, dop853 at two tolerances, and bdf.
+COMMON_CASES = [
+    ("auto (defaults)", {}),
+    ("dop853, rtol = atol = 1e-6", {"integrator": "dop853", "rtol": 1e-6, "atol": 1e-6}),
+    ("dop853, 1e-9", {"integrator": "dop853", "rtol": 1e-9, "atol": 1e-9}),
+    ("bdf, 1e-6", {"integrator": "bdf", "rtol": 1e-6, "atol": 1e-6}),
+]
 
 
 def median_run(build, t_end, settings):
