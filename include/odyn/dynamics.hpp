@@ -863,6 +863,10 @@ CoordinatesChoice choose_coordinates(const Model& model, const DynamicsSettings&
   if constexpr (!std::is_same_v<typename Model::Space, Spatial>) {
     return absolute("a planar model: joint coordinates would cost about as much");
   } else {
+    if (const std::string friction = first_reaction_reader(model); !friction.empty())
+      return absolute(friction +
+                      " reads its joint's reaction, which joint coordinates do not solve while "
+                      "stepping");
     const bool explicit_method =
         s.integrator == "dop853" || s.integrator == "dopri5" || s.integrator == "adams";
     if (!explicit_method && s.integrator != "auto")

@@ -6,6 +6,7 @@
 #include "odyn/core/model.hpp"
 #include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
+#include "odyn/forces/joint_friction.hpp"
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
 #include "odyn/planar/body.hpp"
@@ -29,6 +30,7 @@ using CircleLine = SpherePlaneT<Planar>;
 using CircleCircle = SphereSphereT<Planar>;
 using Gear = GearT<PairJoint, JointFrame>;
 using RackPinion = RackPinionT<PairJoint, JointFrame>;
+using JointFriction = JointFrictionT<PairJoint>;
 
 /// The joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter names.
 inline constexpr auto turning_joint_types = parameters::revolute_joints;
@@ -42,6 +44,6 @@ using Model = odyn::Model<Body, Elements...>;
 using DefaultModel =
     Model<Revolute, Translational, Fixed, Distance, InLine, Gear, RackPinion, RevoluteDriver,
           TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, CircleLine,
-          CircleCircle, RevoluteLimit, TranslationalLimit>;
+          CircleCircle, RevoluteLimit, TranslationalLimit, JointFriction>;
 
 }  // namespace odyn::planar

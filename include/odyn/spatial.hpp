@@ -4,6 +4,7 @@
 #include "odyn/core/model.hpp"
 #include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
+#include "odyn/forces/joint_friction.hpp"
 #include "odyn/forces/point_load.hpp"
 #include "odyn/forces/tsda.hpp"
 #include "odyn/spatial/body.hpp"
@@ -31,6 +32,7 @@ using SpherePlane = SpherePlaneT<Spatial>;
 using SphereSphere = SphereSphereT<Spatial>;
 using Gear = GearT<PairJoint, JointFrame>;
 using RackPinion = RackPinionT<PairJoint, JointFrame>;
+using JointFriction = JointFrictionT<PairJoint>;
 
 /// The joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter names.
 inline constexpr auto turning_joint_types = parameters::turning_joints;
@@ -45,6 +47,6 @@ using DefaultModel =
     Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
           InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion, ScrewJoint,
           RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda,
-          Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit>;
+          Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit, JointFriction>;
 
 }  // namespace odyn::spatial

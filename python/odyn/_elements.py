@@ -471,8 +471,8 @@ class SpatialElements(_Adds):
     def add_revolute_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
-            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
-            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            on_b: Optional[Frame] = None, lower: Optional[float] = None,
+            upper: Optional[float] = None, stiffness: float, exponent: float = 1.0,
             dissipation: float = 0.0) -> str:
         """Stops on a revolute (or cylindrical) joint's angle: past a limit by delta, a torque k
         delta^n (1 + d delta') back towards it.
@@ -502,8 +502,8 @@ class SpatialElements(_Adds):
     def add_translational_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
-            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
-            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            on_b: Optional[Frame] = None, lower: Optional[float] = None,
+            upper: Optional[float] = None, stiffness: float, exponent: float = 1.0,
             dissipation: float = 0.0) -> str:
         """Stops on a translational joint's slide: past a limit by delta, a force k delta^n (1 + d
         delta') back towards it.
@@ -529,6 +529,36 @@ class SpatialElements(_Adds):
             "translational_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
             on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
             dissipation=dissipation)
+
+    def add_joint_friction(
+            self, name: str, joint: str, coefficient: float, *,
+            static_coefficient: Optional[float] = None, stribeck_velocity: float = 0.01,
+            transition_velocity: float = 0.0001, viscous: float = 0.0, preload: float = 0.0,
+            radius: float = 0.0, bending_arm: float = 0.0) -> str:
+        """Friction in a revolute, translational or cylindrical joint: Coulomb with stiction and
+        viscous, from the joint's reaction.
+
+        name: the element's name.
+        joint: the joint whose surfaces rub (added before).
+        coefficient: mu_k: the friction coefficient while slipping.
+        static_coefficient: mu_s >= mu_k: the coefficient at rest (stiction); null: mu_k.
+        stribeck_velocity (m/s): v_s: mu falls from mu_s to mu_k over it.
+        transition_velocity (m/s): v_t: the slip speed over which the friction force builds up; a
+        sticking joint creeps at about this speed (smaller is stiffer).
+        viscous (N s/m): c: adds c times the slip speed.
+        preload (N): a normal load carried besides the reaction.
+        radius (m): the pin radius: the lever of a turning joint's friction (required there).
+        bending_arm (m): the joint's moments across its axis over this arm add to the normal load;
+        0: left out.
+
+        Outputs (Result.output(name)): normal_load (N), slip_speed (m/s), friction (N), force (N),
+        torque (N m), power (W).
+        """
+        return self._add_given(
+            "joint_friction", name=name, joint=joint, coefficient=coefficient,
+            static_coefficient=static_coefficient, stribeck_velocity=stribeck_velocity,
+            transition_velocity=transition_velocity, viscous=viscous, preload=preload,
+            radius=radius, bending_arm=bending_arm)
 
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
@@ -891,8 +921,8 @@ class PlanarElements(_Adds):
     def add_revolute_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
-            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
-            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            on_b: Optional[Frame] = None, lower: Optional[float] = None,
+            upper: Optional[float] = None, stiffness: float, exponent: float = 1.0,
             dissipation: float = 0.0) -> str:
         """Stops on a revolute joint's angle: past a limit by delta, a torque k delta^n (1 + d
         delta') back towards it.
@@ -922,8 +952,8 @@ class PlanarElements(_Adds):
     def add_translational_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
-            on_b: Optional[Frame] = None, lower: Optional[Optional[float]] = None,
-            upper: Optional[Optional[float]] = None, stiffness: float, exponent: float = 1.0,
+            on_b: Optional[Frame] = None, lower: Optional[float] = None,
+            upper: Optional[float] = None, stiffness: float, exponent: float = 1.0,
             dissipation: float = 0.0) -> str:
         """Stops on a translational joint's slide: past a limit by delta, a force k delta^n (1 + d
         delta') back towards it.
@@ -949,6 +979,36 @@ class PlanarElements(_Adds):
             "translational_limit", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b,
             on_b=on_b, lower=lower, upper=upper, stiffness=stiffness, exponent=exponent,
             dissipation=dissipation)
+
+    def add_joint_friction(
+            self, name: str, joint: str, coefficient: float, *,
+            static_coefficient: Optional[float] = None, stribeck_velocity: float = 0.01,
+            transition_velocity: float = 0.0001, viscous: float = 0.0, preload: float = 0.0,
+            radius: float = 0.0, bending_arm: float = 0.0) -> str:
+        """Friction in a revolute, translational or cylindrical joint: Coulomb with stiction and
+        viscous, from the joint's reaction.
+
+        name: the element's name.
+        joint: the joint whose surfaces rub (added before).
+        coefficient: mu_k: the friction coefficient while slipping.
+        static_coefficient: mu_s >= mu_k: the coefficient at rest (stiction); null: mu_k.
+        stribeck_velocity (m/s): v_s: mu falls from mu_s to mu_k over it.
+        transition_velocity (m/s): v_t: the slip speed over which the friction force builds up; a
+        sticking joint creeps at about this speed (smaller is stiffer).
+        viscous (N s/m): c: adds c times the slip speed.
+        preload (N): a normal load carried besides the reaction.
+        radius (m): the pin radius: the lever of a turning joint's friction (required there).
+        bending_arm (m): the joint's moments across its axis over this arm add to the normal load;
+        0: left out.
+
+        Outputs (Result.output(name)): normal_load (N), slip_speed (m/s), friction (N), force (N),
+        torque (N m), power (W).
+        """
+        return self._add_given(
+            "joint_friction", name=name, joint=joint, coefficient=coefficient,
+            static_coefficient=static_coefficient, stribeck_velocity=stribeck_velocity,
+            transition_velocity=transition_velocity, viscous=viscous, preload=preload,
+            radius=radius, bending_arm=bending_arm)
 
     def add_engine_gas_force(
             self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,

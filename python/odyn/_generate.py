@@ -85,7 +85,7 @@ def _signature(parameters: List[Mapping[str, Any]], space: str) -> str:
             out.append("*")
             keyword_only = True
         default = _python_default(p["kind"], p["default"], dim)
-        if default == "None":
+        if default == "None" and not annotation.startswith("Optional["):
             annotation = f"Optional[{annotation}]"
         out.append(f"{p['name']}: {annotation} = {default}")
     return ", ".join(out)

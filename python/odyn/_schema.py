@@ -357,7 +357,15 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     params = {k: v for k, v in params.items() if not (k == "joint" and v is None)}
     required = [k for k, (_, default) in spec.items() if default is REQUIRED]
     driven = DRIVEN_JOINTS[space]
-    if kind in driven:
+    # An element on a joint's bodies and frames (a driver, a stop) takes them from `joint`; one
+    # that sits on the joint itself (friction) keeps its name, checked here.
+    takes_frames = kind in driven and "body_a" in spec
+    if kind in driven and not takes_frames and isinstance(params.get("joint"), str):
+        joint = check_name(params["joint"], f"{where}.joint")
+        if joint not in elements or elements[joint][0] not in driven[kind]:
+            fail(f"{where}.joint", f"no {' or '.join(driven[kind])} joint named '{joint}' "
+                 f"before this {kind}")
+    if takes_frames:
         if "joint" in params:
             # Drive or stop an existing joint: take its bodies and frames.
             joint = check_name(params.pop("joint"), f"{where}.joint")
@@ -383,7 +391,7 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     check_keys(params, where, list(spec), required)
     out: Dict[str, Any] = {}
     for key, (param_kind, default) in spec.items():
-        if key == "joint":
+        if key == "joint" and takes_frames:
             continue  # resolved above into the bodies and frames
         value = params.get(key, default)
         out[key] = kinds[param_kind](value, f"{where}.{key}", bodies)

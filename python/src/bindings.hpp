@@ -290,16 +290,16 @@ using Model =
               sp::ParallelAxes, sp::Perpendicular, sp::Gear, sp::RackPinion, sp::ScrewJoint,
               sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity, sp::PointForce,
               sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing, sp::SpherePlane, sp::SphereSphere,
-              sp::RevoluteLimit, sp::TranslationalLimit, EngineGasForce, UserForceT<Spatial, 1>,
-              UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+              sp::RevoluteLimit, sp::TranslationalLimit, sp::JointFriction, EngineGasForce,
+              UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
-using PlanarModel =
-    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine, pl::Gear,
-              pl::RackPinion, pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity,
-              pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, pl::CircleLine,
-              pl::CircleCircle, pl::RevoluteLimit, pl::TranslationalLimit, PlanarEngineGasForce,
-              UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
+using PlanarModel = pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
+                              pl::Gear, pl::RackPinion, pl::RevoluteDriver, pl::TranslationalDriver,
+                              pl::Gravity, pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda,
+                              pl::Bushing, pl::CircleLine, pl::CircleCircle, pl::RevoluteLimit,
+                              pl::TranslationalLimit, pl::JointFriction, PlanarEngineGasForce,
+                              UserForceT<Planar, 1>, UserForceT<Planar, 2>, SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
 /// DefaultModel): a new element in the library fails this check until the bindings have it.

@@ -557,6 +557,10 @@ def test_gears_are_covered_by_their_own_tests():
     covers("gear", "rack_pinion", "screw")  # tests/python/test_gears.py
 
 
+def test_joint_friction_is_covered_by_its_own_tests():
+    covers("joint_friction")  # tests/python/test_joint_friction.py: closed forms
+
+
 def test_every_element_type_is_tested():
     # Runs last in this file (pytest keeps file order).
     assert set(odyn.element_types) == TESTED

@@ -266,6 +266,10 @@ def test_gears_are_covered_by_their_own_tests():
     covers("gear", "rack_pinion")  # tests/python/test_gears.py
 
 
+def test_joint_friction_is_covered_by_its_own_tests():
+    covers("joint_friction")  # tests/python/test_joint_friction.py: closed forms
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

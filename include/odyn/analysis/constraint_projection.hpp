@@ -7,6 +7,7 @@
 // steps themselves are written once, here.
 
 #include <Eigen/Core>
+#include <string>
 
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/workspace.hpp"
@@ -31,17 +32,46 @@ class ConstraintProjection {
   /// v' and lambda at the workspace's state (frames and constraints evaluated, the solver
   /// factorized there): forces and gamma are evaluated, then [M Phi_q^T; Phi_q 0] [v'; lambda]
   /// = [Q; gamma] is solved. False if the solution is not finite.
+  ///
+  /// With forces that read their joints' reactions (joint friction), Q depends on lambda: the
+  /// solve is repeated, each time with the forces of the last lambda (from the workspace's, the
+  /// last solve's, at first), until lambda changes by at most reaction_tolerance of its size.
+  /// The change shrinks by about mu times the ratio of the friction's lever to the joint's at
+  /// each pass; throws SolverError, naming the friction, where it does not shrink (a friction
+  /// coefficient so large that the reactions have no unique value: Painleve's paradox).
   template <class Solver>
   bool solve_accelerations(const Model& model, Workspace<Model>& ws, Solver& solver) {
-    evaluate_forces(model, ws);
     evaluate_gamma(model, ws);
-    rhs_.head(nv_total_) = ws.force;
     rhs_.tail(m_) = ws.gamma;
-    solver.solve(rhs_, solution_);
-    ws.vdot = solution_.head(nv_total_);
-    ws.lambda = solution_.tail(m_);
-    return all_finite(solution_);
+    constexpr int passes = reads_joint_reactions<Model>() ? max_reaction_passes : 1;
+    double change = 0.0, size = 0.0;
+    for (int pass = 0; pass < passes; ++pass) {
+      evaluate_forces(model, ws);
+      rhs_.head(nv_total_) = ws.force;
+      solver.solve(rhs_, solution_);
+      if constexpr (passes > 1)
+        if (m_ > 0) change = (solution_.tail(m_) - ws.lambda).cwiseAbs().maxCoeff();
+      ws.vdot = solution_.head(nv_total_);
+      ws.lambda = solution_.tail(m_);
+      if (passes == 1 || m_ == 0 || !all_finite(solution_)) return all_finite(solution_);
+      size = ws.lambda.cwiseAbs().maxCoeff();
+      if (change <= reaction_tolerance * size) return true;
+    }
+    // Rounding can keep the last digits moving; a change that has not shrunk far is a failure.
+    if (change > 1e-8 * size)
+      throw SolverError(ws.t, "the reactions that " + first_reaction_reader(model) +
+                                  " reads did not settle in " + std::to_string(passes) +
+                                  " passes (they still change by " + to_text(change / size) +
+                                  " of their size): the friction is too large for the joint's "
+                                  "geometry (Painleve's paradox); reduce its coefficient, its "
+                                  "pin radius or its moments' share (a longer bending_arm)");
+    return true;
   }
+
+  /// How closely the reactions that joint friction reads must settle, relative to the largest
+  /// multiplier, and in how many passes at most.
+  static constexpr double reaction_tolerance = 1e-12;
+  static constexpr int max_reaction_passes = 100;
 
   /// One correction of the positions towards Phi = 0: [M Phi_q^T; Phi_q 0] [dq; mu] = [0; -Phi]
   /// with the solver's matrix (factorized at these positions, or near them: a chord step), each

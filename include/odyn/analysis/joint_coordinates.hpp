@@ -175,6 +175,11 @@ class JointCoordinates {
   JointCoordinates(const Model& model, Workspace<Model>& ws,
                    LinearSolver /*linear_solver*/ = LinearSolver::automatic, int slots = 1)
       : model_(model), ws_(ws), slots_(std::clamp(slots, 1, max_slots)) {
+    if (const std::string friction = first_reaction_reader(model); !friction.empty())
+      throw ModelError(friction,
+                       "reads its joint's reaction, which joint coordinates do not solve while "
+                       "stepping; run it in absolute coordinates (coordinates 'absolute' or "
+                       "'auto')");
     odyn::update_frames(model, ws);
     build_tree();
     size_buffers();

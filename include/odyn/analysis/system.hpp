@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <type_traits>
 
 #include "odyn/core/element.hpp"
@@ -66,7 +67,49 @@ void evaluate_gamma(const Model& model, Workspace<Model>& ws) {
   });
 }
 
+/// The constraint force of the constraint at (type, index) in the model's lists on its second
+/// body, -Phi_q,b^T lambda (generalized, at b's centre), from the workspace's last evaluated
+/// blocks and its multipliers.
+template <class Model>
+typename Model::Space::Velocity constraint_force_on_b(const Model& model,
+                                                      const Workspace<Model>& ws, std::size_t type,
+                                                      std::size_t index) {
+  typename Model::Space::Velocity force = Model::Space::Velocity::Zero();
+  model.for_each_pool([&]<class E>(const std::vector<E>&, auto pool_type) {
+    if constexpr (Constraint<E>) {
+      if constexpr (E::num_bodies >= 2) {
+        if (pool_type != type) return;
+        const auto& blocks = std::get<pool_type>(ws.blocks)[index];
+        const int row = model.template rows<E>()[index];
+        force.noalias() =
+            -blocks.jacobian[1].transpose() * ws.lambda.template segment<E::num_equations>(row);
+      }
+    }
+  });
+  return force;
+}
+
+/// True if some force element type of the model reads its joint's reaction (ReadsJointReaction).
+template <class Model>
+constexpr bool reads_joint_reactions() {
+  return []<class B, class... E>(const odyn::Model<B, E...>*) {
+    return (ReadsJointReaction<E> || ...);
+  }(static_cast<const Model*>(nullptr));
+}
+
+/// The name of the model's first element that reads its joint's reaction; empty if none.
+template <class Model>
+std::string first_reaction_reader(const Model& model) {
+  std::string found;
+  model.for_each_pool([&]<class E>(const std::vector<E>& pool, auto) {
+    if constexpr (ReadsJointReaction<E>)
+      if (found.empty() && !pool.empty()) found = pool.front().name();
+  });
+  return found;
+}
+
 /// Applied forces: Q from every force element, field forces and the bodies' gyroscopic terms.
+/// An element that reads its joint's reaction gets it from the multipliers the workspace holds.
 template <class Model>
 void evaluate_forces(const Model& model, Workspace<Model>& ws) {
   using Space = typename Model::Space;
@@ -91,6 +134,9 @@ void evaluate_forces(const Model& model, Workspace<Model>& ws) {
       auto& blocks = std::get<type>(ws.blocks);
       for (std::size_t i = 0; i < pool.size(); ++i) {
         const auto in = detail::input_of(pool[i], ws.frames, ws.t);
+        if constexpr (ReadsJointReaction<E>)
+          std::get<type>(ws.states)[i].reaction =
+              constraint_force_on_b(model, ws, pool[i].joint_type(), pool[i].joint_index());
         if constexpr (StatefulForce<E>)
           pool[i].evaluate(in, std::get<type>(ws.states)[i], blocks[i]);
         else

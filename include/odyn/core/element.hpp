@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <concepts>
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -175,6 +176,24 @@ concept LimitsSteps =
     Stateful<E> && requires(const E& e, const InputOf<E>& in, const typename E::State& s) {
       { e.step_limit(in, s) } -> std::convertible_to<double>;
     };
+
+/// Optional: an element that sits on a joint added to the model before it (joint friction).
+/// Model::add finds the joint by `joint_name()` and calls `attach(joint, type, index)` with
+/// it and its place in the model (its type's position in the model's list, its index there).
+template <class E>
+concept OnJoint = NamedElement<E> && requires(const E& e) {
+  { e.joint_name() } -> std::convertible_to<std::string>;
+  { e.joint_type() } -> std::convertible_to<std::size_t>;
+  { e.joint_index() } -> std::convertible_to<std::size_t>;
+};
+
+/// Optional: a stateful force on a joint whose law reads the joint's reaction (friction from
+/// the normal load). Its state's `reaction` is the joint's constraint force on its body b,
+/// -Phi_q,b^T lambda, which the system refreshes from the multipliers before each evaluation.
+template <class E>
+concept ReadsJointReaction = StatefulForce<E> && OnJoint<E> && requires(typename E::State& s) {
+  { s.reaction } -> std::convertible_to<typename E::Space::Velocity>;
+};
 
 /// Optional: a force element with a potential energy.
 template <class E>

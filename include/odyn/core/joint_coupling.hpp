@@ -126,8 +126,6 @@ class JointCouplingT {
   double coordinate(const Input& in, const State& state, int i) const {
     return row(pair_input(in, i), i, state.angle[i]).value;
   }
-  /// The i-th coordinate's value at the initial pose.
-  double initial(int i) const { return initial_[i]; }
 
  protected:
   /// Refuses a zero or non-finite parameter (a ratio, a radius, a pitch), naming it.

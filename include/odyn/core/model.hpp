@@ -75,6 +75,7 @@ class Model {
   template <class E>
   requires holds<E> Handle<E> add(E element) {
     claim_name(element.name());
+    if constexpr (OnJoint<E>) attach_to_joint(element);
     if constexpr (!FieldForce<E>) {
       check_bodies(element.name(), element.bodies());
       if constexpr (BindsToInitialPose<E>) {
@@ -202,6 +203,27 @@ class Model {
     if (name.empty()) throw ModelError("(unnamed)", "every body and element needs a name");
     if (body_names_.count(name) || element_names_.count(name))
       throw ModelError(name, "the name is already used in this model; names must be unique");
+  }
+
+  /// Gives an element that sits on a joint (OnJoint) that joint and its place in the model.
+  template <class E>
+  void attach_to_joint(E& element) const {
+    const std::string joint = element.joint_name();
+    const auto it = element_names_.find(joint);
+    if (it == element_names_.end())
+      throw ModelError(element.name(), "no joint named '" + joint +
+                                           "' in the model; add the joint before the elements "
+                                           "that sit on it");
+    bool attached = false;
+    for_each_pool([&]<class J>(const std::vector<J>& pool, auto type) {
+      if constexpr (requires { element.attach(pool.front(), type, it->second.index); }) {
+        if (type != it->second.type) return;
+        element.attach(pool[it->second.index], type, it->second.index);
+        attached = true;
+      }
+    });
+    if (!attached)
+      throw ModelError(element.name(), "'" + joint + "' is not a joint this element can sit on");
   }
 
   template <std::size_t N>

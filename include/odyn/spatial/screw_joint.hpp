@@ -2,7 +2,7 @@
 // A screw: b's point slides along a's axis by `pitch` for each turn of b about it,
 // s - s0 = pitch (theta - theta0) / (2 pi), one equation (core/joint_coupling.hpp). With a
 // cylindrical joint between the same frames it makes a lead screw or a nut; on its own it
-// leaves the other four relative motions free.
+// leaves the other five relative motions free (one equation removes one of the six).
 
 #include <array>
 #include <numbers>
