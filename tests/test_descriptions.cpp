@@ -74,12 +74,16 @@ class InventedValues {
   const odyn::ElementDescription& description_;
 };
 
-/// The parameters a front end hands to from_parameters: all but a driver's or a stop's `joint`,
-/// which it resolves into the bodies and frames.
+/// The parameters a front end hands to from_parameters: all but the `joint` of an element that
+/// takes a joint's bodies and frames (a driver, a stop), which it resolves into them. An element
+/// that sits on the joint itself (friction) reads the joint's name.
 std::set<std::string> handed_over(const odyn::ElementDescription& description) {
+  bool takes_frames = false;
+  for (const odyn::Parameter& p : description.parameters)
+    takes_frames = takes_frames || std::string(p.name) == "body_a";
   std::set<std::string> out;
   for (const odyn::Parameter& p : description.parameters)
-    if (std::string(p.name) != "joint") out.insert(p.name);
+    if (!takes_frames || std::string(p.name) != "joint") out.insert(p.name);
   return out;
 }
 
@@ -92,7 +96,15 @@ void check_description() {
   const odyn::ElementDescription& d = E::description;
   INFO(d.type);
   InventedValues values(d);
-  const E element = E::from_parameters(values);
+  E element = E::from_parameters(values);
+  if constexpr (odyn::OnJoint<E>) {
+    // It takes its bodies from its joint when a model adds it: a hinge between bodies 1 and 2.
+    using Space = typename E::Space;
+    using Revolute = std::conditional_t<std::is_same_v<Space, odyn::Spatial>,
+                                        odyn::spatial::Revolute, odyn::planar::Revolute>;
+    CHECK(element.joint_name() == "element joint");
+    element.attach(Revolute("hinge", odyn::BodyId{1}, {}, odyn::BodyId{2}, {}), 0, 0);
+  }
   CHECK(values.read == handed_over(d));
   CHECK(element.name() == "element name");
   const std::string category = d.category;

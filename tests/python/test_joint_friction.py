@@ -1,9 +1,12 @@
 """Joint friction from Python and scene files, against closed forms: a block launched down a
 slope flatter than the friction angle slows at g (mu_k cos - sin), sticks and creeps at
 v_t atanh(tan / mu_s), in space and in the plane; a pendulum's energy falls by the integral of
-its pin friction's power output; scene round trips; bad input refused by name."""
+its pin friction's power output; a block on a moving belt sticks and slips with the period of
+Coulomb's law as the Stribeck velocity falls; scene round trips; bad input refused by name."""
 
+import importlib.util
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -182,6 +185,35 @@ def test_a_friction_that_feeds_itself_without_bound_is_refused_by_name():
     error naming the friction instead of returning a load."""
     with pytest.raises(odyn.SolverError, match="rubbing.*did not settle"):
         odyn.simulate(tall_slider(0.1), t_end=0.2, output_interval=0.1, integrator="dop853")
+
+
+def _stick_slip_example():
+    path = pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" / "stick_slip.py"
+    spec = importlib.util.spec_from_file_location("stick_slip", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_block_on_a_belt_sticks_and_slips_with_coulombs_period():
+    """The friction between two moving bodies (a driven belt and a block held by a spring):
+    the limit cycle's period and the block's farthest reach approach Coulomb's closed forms as
+    the Stribeck velocity v_s falls (v_t = v_s / 100)."""
+    example = _stick_slip_example()
+    k, mass, mu, mu_s, speed = 100.0, 1.0, 0.4, 0.6, 0.05
+    omega, gap = math.sqrt(k / mass), (mu_s - mu) * mass * G / k
+    reach = mu * mass * G / k + math.hypot(gap, speed / omega)  # the slip's swing
+    errors = []
+    for v_s in (1e-2, 1e-4):
+        r = odyn.simulate(example.belt_and_block(stribeck_velocity=v_s,
+                                                 transition_velocity=v_s / 100),
+                          t_end=6.0, output_interval=1e-4, rtol=1e-9, atol=1e-11)
+        period = np.diff(example.slip_onsets(r))[-1]
+        errors.append(abs(period / example.coulomb_period() - 1))
+        x = r.body("block").position[:, 0]
+        if v_s == 1e-4:
+            assert x.max() == pytest.approx(reach, rel=1e-3)
+    assert errors[1] < 2e-3 and errors[0] > 10 * errors[1]
 
 
 def test_friction_round_trips_through_a_scene_file(tmp_path):
