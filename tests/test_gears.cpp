@@ -5,7 +5,7 @@
 //   tested, not their on-joint shortcut), and its angle counting the state's whole turns;
 // - a torque-driven gear pair turns as one rigid inertia I_a + ratio^2 I_b, for many turns and
 //   a ratio that is not an integer, in space and in the plane, in absolute and joint
-//   coordinates, with dop853 and generalized-alpha;
+//   coordinates, with dop853 and generalized-alpha, its mesh passing I_a accel - T to gear a;
 // - a pushed rack drives its pinion at s = r theta with (m + I / r^2) s'' = F;
 // - a nut on a vertical lead screw sinks under gravity at g m / (m + I (2 pi / p)^2);
 // - zero ratios, radii and pitches are refused by name.
@@ -210,6 +210,11 @@ TEST_CASE("A gear pair turns as one inertia, for many turns", "[gears]") {
         CHECK(turn_error(2, axis_b, ratio * angle_a) < tolerance * angle_a);
         const Vector3d omega_b = ws.frames[2].rotation * ws.frames[2].angular_velocity;
         CHECK((omega_b - ratio * accel * t_end * axis_b).norm() < tolerance * accel * t_end);
+        // The mesh's torques: I_a accel - T on gear a, I_b theta_b'' on gear b.
+        CHECK(odyn::element_output(model, ws, "mesh", "torque_a") ==
+              Approx(-ratio * ratio * inertia_b * accel).epsilon(1e3 * tolerance));
+        CHECK(odyn::element_output(model, ws, "mesh", "torque_b") ==
+              Approx(ratio * inertia_b * accel).epsilon(1e3 * tolerance));
       }
       SECTION(std::string("in the plane, ") + integrator + ", " + coordinates) {
         pl::DefaultModel model;

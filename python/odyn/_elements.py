@@ -220,7 +220,8 @@ class SpatialElements(_Adds):
         ratio: theta_b' / theta_a', nonzero; negative when b turns against a about axes pointing
         alike.
 
-        Outputs (Result.output(name)): angle_a (rad), angle_b (rad).
+        Outputs (Result.output(name)): angle_a (rad), angle_b (rad), torque_a (N m), torque_b (N
+        m).
         """
         return self._add_given("gear", name=name, joint_a=joint_a, joint_b=joint_b, ratio=ratio)
 
@@ -233,7 +234,7 @@ class SpatialElements(_Adds):
         rack: the rack's joint (its slide s).
         radius (m): s' / theta': the pinion's pitch radius, nonzero, its sign the rack's direction.
 
-        Outputs (Result.output(name)): angle (rad), slide (m).
+        Outputs (Result.output(name)): angle (rad), slide (m), torque (N m), force (N).
         """
         return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
 
@@ -253,7 +254,7 @@ class SpatialElements(_Adds):
         on_b (m): the joint's frame on body b (without joint).
         pitch (m): the slide per turn, nonzero; negative for a left-handed thread.
 
-        Outputs (Result.output(name)): angle (rad), slide (m).
+        Outputs (Result.output(name)): angle (rad), slide (m), torque (N m), force (N).
         """
         return self._add_given(
             "screw", name=name, joint=joint, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b,
@@ -696,7 +697,8 @@ class PlanarElements(_Adds):
         ratio: theta_b' / theta_a', nonzero; negative when b turns against a about axes pointing
         alike.
 
-        Outputs (Result.output(name)): angle_a (rad), angle_b (rad).
+        Outputs (Result.output(name)): angle_a (rad), angle_b (rad), torque_a (N m), torque_b (N
+        m).
         """
         return self._add_given("gear", name=name, joint_a=joint_a, joint_b=joint_b, ratio=ratio)
 
@@ -709,7 +711,7 @@ class PlanarElements(_Adds):
         rack: the rack's joint (its slide s).
         radius (m): s' / theta': the pinion's pitch radius, nonzero, its sign the rack's direction.
 
-        Outputs (Result.output(name)): angle (rad), slide (m).
+        Outputs (Result.output(name)): angle (rad), slide (m), torque (N m), force (N).
         """
         return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
 

@@ -1,7 +1,8 @@
 """Gears, rack and pinion, and screw (spatial and planar), against closed forms: a torque-driven
 gear pair turns as one inertia I_a + ratio^2 I_b for many turns (with the mesh torque on gear a
-from the reactions), a three-gear train's work-energy balance, a pushed rack and its pinion,
-a nut sinking down a lead screw; scene files and bad input."""
+from the reactions and the outputs), a three-gear train's work-energy balance, a pushed rack
+and its pinion, a nut sinking down a lead screw (with the torque and force the coupling passes
+on); scene files and bad input."""
 
 import json
 import math
@@ -54,6 +55,11 @@ def test_a_gear_pair_turns_as_one_inertia(space, coordinates, integrator):
     mesh_torque = r.reaction("mesh", side="b").torque
     mesh_torque = mesh_torque[:, 2] if space == "spatial" else mesh_torque
     np.testing.assert_allclose(mesh_torque[1:], -ratio ** 2 * inertia_b * accel,
+                               rtol=10 * tolerance)
+    # The outputs name the mesh's torque on each gear: I_a accel - T on a, I_b theta_b'' on b.
+    np.testing.assert_allclose(r.output("mesh", "torque_a")[1:], -ratio ** 2 * inertia_b * accel,
+                               rtol=10 * tolerance)
+    np.testing.assert_allclose(r.output("mesh", "torque_b")[1:], ratio * inertia_b * accel,
                                rtol=10 * tolerance)
 
 
@@ -135,6 +141,11 @@ def test_a_pushed_rack_drives_its_pinion(space, tmp_path):
                                    rtol=1e-9, atol=1e-12)
         np.testing.assert_allclose(r.output("drive", "angle"),
                                    -0.5 * accel * r.t ** 2 / radius, rtol=1e-9, atol=1e-12)
+        # The mesh turns the pinion with I theta'' and holds the rack back by (I / r^2) s''.
+        np.testing.assert_allclose(r.output("drive", "torque")[1:], -inertia * accel / radius,
+                                   rtol=1e-8)
+        np.testing.assert_allclose(r.output("drive", "force")[1:],
+                                   -inertia / radius ** 2 * accel, rtol=1e-8)
     saved = json.loads(path.read_text())
     (drive,) = [j for j in saved["joints"] if j["name"] == "drive"]
     assert drive["pinion"]["body_b"] == "pinion" and drive["rack"]["body_b"] == "rack"
@@ -157,6 +168,10 @@ def test_a_nut_sinks_down_a_lead_screw(coordinates):
                                atol=1e-13)
     np.testing.assert_allclose(r.output("thread", "angle"), lead * 0.5 * accel * r.t ** 2,
                                rtol=1e-9, atol=1e-10)
+    # The thread spins the nut with J theta'' and holds it up by m (s'' + g).
+    np.testing.assert_allclose(r.output("thread", "torque")[1:], inertia * lead * accel,
+                               rtol=1e-8)
+    np.testing.assert_allclose(r.output("thread", "force")[1:], mass * (accel + G), rtol=1e-8)
 
 
 @pytest.mark.parametrize("kwargs, words", [

@@ -22,7 +22,13 @@ std::array<double, num_outputs<E>> element_outputs(const Model& model, const Wor
                                                    Handle<E> handle) {
   const E& element = model.element(handle);
   const auto& states = std::get<Model::template type_index<E>>(ws.states);
-  return outputs_of(element, detail::input_of(element, ws.frames, ws.t), states[handle.index]);
+  const auto in = detail::input_of(element, ws.frames, ws.t);
+  if constexpr (HasMultiplierOutputs<E>)
+    return outputs_of(element, in, states[handle.index],
+                      Eigen::Matrix<double, E::num_equations, 1>(
+                          ws.lambda.template segment<E::num_equations>(model.row(handle))));
+  else
+    return outputs_of(element, in, states[handle.index], 0.0);
 }
 
 /// One output of the element `name`, by the output's name; throws ModelError naming the

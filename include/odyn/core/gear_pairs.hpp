@@ -5,7 +5,8 @@
 //   RackPinionT  s - s0 = radius (theta - theta0): a slider's slide and a hinge's angle.
 // Each couples existing joints' coordinates (their bodies and frames), measured as their drivers
 // measure them. The multiplier is the torque (gear) or force (rack) the mesh passes on to the
-// second joint's coordinate; the reactions report it on the bodies.
+// second joint's coordinate; the reactions report it on the bodies, and the outputs as the
+// torque or force on each joint's coordinate.
 
 #include <array>
 #include <string>
@@ -35,14 +36,20 @@ inline constexpr std::array<Parameter, 4> rack_pinion{{
      "s' / theta': the pinion's pitch radius, nonzero, its sign the rack's direction"},
 }};
 
-inline constexpr std::array<Output, 2> gear_outputs{{
+inline constexpr std::array<Output, 4> gear_outputs{{
     {"angle_a", "rad", "the first joint's angle, counting turns"},
     {"angle_b", "rad", "the second joint's angle, counting turns"},
+    {"torque_a", "N m",
+     "the mesh's torque on the first gear (joint_a's body b) about its axis; the tooth force is "
+     "it over the gear's pitch radius"},
+    {"torque_b", "N m", "the mesh's torque on the second gear about its axis"},
 }};
 
-inline constexpr std::array<Output, 2> angle_and_slide{{
+inline constexpr std::array<Output, 4> angle_and_slide{{
     {"angle", "rad", "the turning joint's angle, counting turns"},
     {"slide", "m", "the sliding joint's slide"},
+    {"torque", "N m", "the coupling's torque on the turning joint's body b about its axis"},
+    {"force", "N", "the coupling's force on the sliding joint's body b along its axis"},
 }};
 
 }  // namespace parameters
@@ -77,8 +84,10 @@ class GearT : public JointCouplingT<Pair, 2> {
 
   double ratio() const { return -this->term(0).coefficient; }
 
-  std::array<double, 2> outputs(const Input& in, const State& state) const {
-    return {this->coordinate(in, state, 0), this->coordinate(in, state, 1)};
+  std::array<double, 4> outputs(const Input& in, const State& state,
+                                const Eigen::Matrix<double, 1, 1>& lambda) const {
+    return {this->coordinate(in, state, 0), this->coordinate(in, state, 1), this->effort(lambda, 0),
+            this->effort(lambda, 1)};
   }
 };
 
@@ -112,8 +121,10 @@ class RackPinionT : public JointCouplingT<Pair, 2> {
 
   double radius() const { return -this->term(0).coefficient; }
 
-  std::array<double, 2> outputs(const Input& in, const State& state) const {
-    return {this->coordinate(in, state, 0), this->coordinate(in, state, 1)};
+  std::array<double, 4> outputs(const Input& in, const State& state,
+                                const Eigen::Matrix<double, 1, 1>& lambda) const {
+    return {this->coordinate(in, state, 0), this->coordinate(in, state, 1), this->effort(lambda, 0),
+            this->effort(lambda, 1)};
   }
 };
 

@@ -126,6 +126,11 @@ class JointCouplingT {
   double coordinate(const Input& in, const State& state, int i) const {
     return row(pair_input(in, i), i, state.angle[i]).value;
   }
+  /// The coupling's effort on the i-th coordinate, -c_i lambda (a torque on an angle, a force on
+  /// a slide, acting on the joint's body b, against body a): what -Phi_q^T lambda puts there.
+  double effort(const Eigen::Matrix<double, 1, 1>& lambda, int i) const {
+    return -terms_[i].coefficient * lambda[0];
+  }
 
  protected:
   /// Refuses a zero or non-finite parameter (a ratio, a radius, a pitch), naming it.

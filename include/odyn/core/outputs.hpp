@@ -5,8 +5,10 @@
 // computes them, in that order, with
 //     std::array<double, K> outputs(const Input& in) const;                    or, stateful:
 //     std::array<double, K> outputs(const Input& in, const State& state) const;
-// where K is the length of the description's list. Results record them at every output time.
+// where K is the length of the description's list; a constraint may also read its multipliers
+// (HasMultiplierOutputs). Results record them at every output time.
 
+#include <Eigen/Core>
 #include <array>
 #include <cstddef>
 
@@ -31,20 +33,35 @@ concept HasStatefulOutputs =
       { e.outputs(in, state) } -> std::same_as<std::array<double, num_outputs<E>>>;
     };
 
+/// A constraint whose outputs also read its multipliers (a gear's mesh torque):
+///     std::array<double, K> outputs(const Input& in, const State& state,
+///                                   const Eigen::Matrix<double, M, 1>& lambda) const;
+template <class E>
+concept HasMultiplierOutputs =
+    Described<E> && StatefulConstraint<E> &&
+    requires(const E& e, const InputOf<E>& in, const typename E::State& state,
+             const Eigen::Matrix<double, E::num_equations, 1>& lambda) {
+      { e.outputs(in, state, lambda) } -> std::same_as<std::array<double, num_outputs<E>>>;
+    };
+
 /// Optional: an element that reports outputs.
 template <class E>
-concept HasOutputs = (HasStatelessOutputs<E> || HasStatefulOutputs<E>) && num_outputs<E> > 0;
+concept HasOutputs = (HasStatelessOutputs<E> || HasStatefulOutputs<E> || HasMultiplierOutputs<E>) &&
+                     num_outputs<E> > 0;
 
 /// True for a described element whose outputs() does not match its listed outputs (missing, or
 /// of another length): a mistake that would leave its outputs unrecorded, so front ends refuse it.
 template <class E>
 concept ListsOutputsItDoesNotCompute = Described<E> && num_outputs<E> > 0 && !HasOutputs<E>;
 
-/// The element's outputs at `in` (`state` is read by a stateful element only).
-template <HasOutputs E>
+/// The element's outputs at `in` (`state` is read by a stateful element only, `lambda`, its
+/// multipliers, by one with HasMultiplierOutputs only).
+template <HasOutputs E, class Multipliers>
 std::array<double, num_outputs<E>> outputs_of(const E& element, const InputOf<E>& in,
-                                              const StateOf<E>& state) {
-  if constexpr (HasStatefulOutputs<E>)
+                                              const StateOf<E>& state, const Multipliers& lambda) {
+  if constexpr (HasMultiplierOutputs<E>)
+    return element.outputs(in, state, lambda);
+  else if constexpr (HasStatefulOutputs<E>)
     return element.outputs(in, state);
   else
     return element.outputs(in);

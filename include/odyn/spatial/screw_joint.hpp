@@ -49,8 +49,10 @@ class ScrewJoint : public JointCouplingT<PairJoint, 2> {
 
   double pitch() const { return -2.0 * std::numbers::pi * term(0).coefficient; }
 
-  std::array<double, 2> outputs(const Input& in, const State& state) const {
-    return {coordinate(in, state, 0), coordinate(in, state, 1)};
+  std::array<double, 4> outputs(const Input& in, const State& state,
+                                const Eigen::Matrix<double, 1, 1>& lambda) const {
+    return {coordinate(in, state, 0), coordinate(in, state, 1), effort(lambda, 0),
+            effort(lambda, 1)};
   }
 
  private:
