@@ -140,6 +140,10 @@ sp::Universal make_joint(const Scene& s, BodyId a, BodyId b) {
   return sp::Universal("cardan", a, s.on_a, b, s.on_b_cross);
 }
 template <>
+sp::CvJoint make_joint(const Scene& s, BodyId a, BodyId b) {
+  return sp::CvJoint("cv", a, s.on_a, b, s.on_b);
+}
+template <>
 sp::Cylindrical make_joint(const Scene& s, BodyId a, BodyId b) {
   return sp::Cylindrical("cylinder", a, s.on_a, b, s.on_b);
 }
@@ -419,6 +423,8 @@ double geometric_residual(const Scene& s, const Pose& a, const Pose& b, double t
   if constexpr (std::is_same_v<E, sp::Spherical>) return (pa - pb).norm();
   if constexpr (std::is_same_v<E, sp::Universal>)
     return std::max((pa - pb).norm(), std::abs(za.dot(b.axis(s.on_b_cross))));
+  if constexpr (std::is_same_v<E, sp::CvJoint>)  // no twist: u_a . v_b = v_a . u_b
+    return std::max((pa - pb).norm(), std::abs(xa.dot(zb.cross(xb)) - ya.dot(xb)));
   if constexpr (std::is_same_v<E, sp::Cylindrical>)
     return std::max(za.cross(zb).norm(), (pb - pa).cross(za).norm());
   if constexpr (std::is_same_v<E, sp::Translational>)
@@ -497,6 +503,9 @@ TEST_CASE("Spherical: Jacobian, Phi_t, gamma and assembly", "[joints]") {
 }
 TEST_CASE("Universal: Jacobian, Phi_t, gamma and assembly", "[joints]") {
   check_constraint_type<sp::Universal>();
+}
+TEST_CASE("CvJoint: Jacobian, Phi_t, gamma and assembly", "[joints]") {
+  check_constraint_type<sp::CvJoint>();
 }
 TEST_CASE("Cylindrical: Jacobian, Phi_t, gamma and assembly", "[joints]") {
   check_constraint_type<sp::Cylindrical>();
@@ -622,6 +631,106 @@ TEST_CASE("A block on an inclined planar joint slides and spins as the closed fo
     INFO("position " << ws.q.head<3>().transpose() << " vs " << position.transpose());
     CHECK((ws.q.head<3>() - position).norm() < 1e-8);
     CHECK(q.angularDistance(orientation) < 1e-8);
+  }
+}
+
+TEST_CASE(
+    "A bent driveline: a constant-velocity joint turns its output shaft with the input, "
+    "a universal joint as tan psi = tan phi / cos beta",
+    "[joints]") {
+  // Shaft a turns about z at the constant rate omega (a driver on its bearing); shaft b's axis
+  // d is z tilted by beta about y (a parallel-axes primitive to the ground), and the joint
+  // between them sits where the axes cross. b's pose is R(d, psi) R(y, beta), with psi = phi
+  // for the constant-velocity joint and tan psi = tan phi / cos beta for a cross with its arms
+  // along x on a and y on b. A load torque T against b's turning needs a motor torque T on a
+  // through the constant-velocity joint (equal speeds: the power goes through).
+  const double beta = 0.5, omega = 3.0 * std::numbers::pi, load = 2.5, t_end = 1.3;
+  const Vector3d z = Vector3d::UnitZ(), d(std::sin(beta), 0.0, std::cos(beta));
+  const Eigen::AngleAxisd tilt(beta, Vector3d::UnitY());
+  const auto output_angle = [&](bool homokinetic, double phi) {
+    return homokinetic ? phi : std::atan2(std::sin(phi), std::cos(phi) * std::cos(beta));
+  };
+  for (const bool homokinetic : {true, false}) {
+    for (const char* coordinates : {"absolute", "joint"}) {
+      SECTION(std::string(homokinetic ? "constant-velocity" : "universal") + ", " + coordinates) {
+        Model model;
+        sp::Body shaft_a{
+            .name = "shaft a", .mass = 1.0, .inertia = sp::Body::principal(0.02, 0.02, 0.01)};
+        shaft_a.position = Vector3d(0.0, 0.0, -0.5);
+        sp::Body shaft_b = shaft_a;
+        shaft_b.name = "shaft b";
+        shaft_b.position = 0.5 * d;
+        shaft_b.orientation = Quaterniond(tilt);
+        const BodyId a = model.add_body(shaft_a), b = model.add_body(shaft_b);
+        const sp::Revolute bearing("bearing", odyn::ground, {Vector3d(0, 0, -0.5), z}, a, {});
+        model.add(bearing);
+        model.add(sp::ParallelAxes("guide", odyn::ground, {0.5 * d, d}, b, {}));
+        const sp::JointFrame end_a{Vector3d(0, 0, 0.5), z}, end_b{Vector3d(0, 0, -0.5), z};
+        if (homokinetic)
+          model.add(sp::CvJoint("joint", a, end_a, b, end_b));
+        else
+          model.add(sp::Universal("joint", a, {end_a.point, Vector3d::UnitX()}, b,
+                                  {end_b.point, Vector3d::UnitY()}));
+        const auto motor =
+            model.add(sp::RevoluteDriver("motor", bearing, odyn::Motion::constant_velocity(omega)));
+        model.add(sp::PointTorque("load", b, Vector3d(-load * d)));
+        Workspace ws(model);
+        odyn::DynamicsSettings settings;
+        settings.integrator = "dop853";
+        settings.coordinates = coordinates;
+        settings.rtol = settings.atol = 1e-11;
+        settings.t_end = t_end;
+        settings.output_interval = 0.05;
+        double angle_error = 0.0, speed_error = 0.0;
+        int outputs = 0;
+        const odyn::RunSummary summary =
+            odyn::simulate(model, ws, settings, [&](const auto& state) {
+              const double phi = omega * state.t, psi = output_angle(homokinetic, phi);
+              const Matrix3d expected = (Eigen::AngleAxisd(psi, d) * tilt).toRotationMatrix();
+              angle_error =
+                  std::max(angle_error, (state.frames[b.index].rotation - expected).norm());
+              const Vector3d spin =
+                  state.frames[b.index].rotation * state.frames[b.index].angular_velocity;
+              // psi' = omega cos(beta) / (1 - sin^2(beta) cos^2(phi)) for the cross.
+              const double c = std::cos(phi), s = std::sin(beta);
+              const double rate =
+                  homokinetic ? omega : omega * std::cos(beta) / (1.0 - s * s * c * c);
+              speed_error = std::max(speed_error, (spin - rate * d).norm() / omega);
+              ++outputs;
+            });
+        INFO("largest angle error " << angle_error << ", speed error " << speed_error);
+        CHECK(summary.coordinates == coordinates);
+        CHECK(outputs == 27);
+        CHECK(angle_error < 1e-8);
+        CHECK(speed_error < 1e-8);
+        if (homokinetic) {
+          const auto motor_wrench = odyn::reaction(model, ws, motor, odyn::Side::b);
+          INFO("motor torque " << motor_wrench.torque.transpose());
+          CHECK(motor_wrench.torque.dot(z) == Approx(load).epsilon(1e-8));
+          CHECK(odyn::element_output(model, ws, "joint", "bend") == Approx(beta).epsilon(1e-10));
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("A constant-velocity joint refuses a start on its wrong branch", "[joints][errors]") {
+  Model model;
+  const BodyId b = model.add_body(
+      sp::Body{.name = "shaft", .mass = 1.0, .inertia = sp::Body::principal(0.1, 0.1, 0.1)});
+  SECTION("references twisted by more than a quarter turn") {
+    CHECK_THROWS_WITH(
+        model.add(sp::CvJoint("cv", odyn::ground,
+                              {Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX()}, b,
+                              {Vector3d::Zero(), Vector3d::UnitZ(), Vector3d(-1.0, 0.2, 0.0)})),
+        Catch::Contains("'cv'") && Catch::Contains("twisted by 168.") &&
+            Catch::Contains("leave one out"));
+  }
+  SECTION("shafts pointing in opposite directions") {
+    CHECK_THROWS_WITH(
+        model.add(sp::CvJoint("cv", odyn::ground, {Vector3d::Zero(), Vector3d::UnitZ()}, b,
+                              {Vector3d::Zero(), -Vector3d::UnitZ()})),
+        Catch::Contains("opposite directions"));
   }
 }
 

@@ -9,6 +9,7 @@
 #include "odyn/forces/tsda.hpp"
 #include "odyn/spatial/body.hpp"
 #include "odyn/spatial/bushing.hpp"
+#include "odyn/spatial/cv_joint.hpp"
 #include "odyn/spatial/cylindrical.hpp"
 #include "odyn/spatial/distance.hpp"
 #include "odyn/spatial/drivers.hpp"
@@ -44,9 +45,10 @@ using Model = odyn::Model<Body, Elements...>;
 
 /// Every spatial element type of the library (what scripting uses).
 using DefaultModel =
-    Model<Revolute, Translational, Spherical, Universal, Cylindrical, Fixed, Distance, PlanarJoint,
-          InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion, ScrewJoint,
-          RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda,
-          Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit, JointFriction>;
+    Model<Revolute, Translational, Spherical, Universal, CvJoint, Cylindrical, Fixed, Distance,
+          PlanarJoint, InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion,
+          ScrewJoint, RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda,
+          Rsda, Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit,
+          JointFriction>;
 
 }  // namespace odyn::spatial

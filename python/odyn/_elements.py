@@ -77,6 +77,23 @@ class SpatialElements(_Adds):
         return self._add_given(
             "universal", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
 
+    def add_cv_joint(
+            self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
+            on_b: Optional[Frame] = None) -> str:
+        """Constant-velocity (homokinetic): the points coincide and b's frame is a's turned about
+        an axis across the shafts, so both turn at the same rate at any bend. 4 equations.
+
+        name: the element's name.
+        body_a: the first body.
+        on_a (m): the joint's frame on body a.
+        body_b: the second body.
+        on_b (m): the joint's frame on body b.
+
+        Outputs (Result.output(name)): bend (rad).
+        """
+        return self._add_given(
+            "cv_joint", name=name, body_a=body_a, on_a=on_a, body_b=body_b, on_b=on_b)
+
     def add_cylindrical(
             self, name: str, body_a: str, *, on_a: Optional[Frame] = None, body_b: str,
             on_b: Optional[Frame] = None) -> str:

@@ -285,13 +285,13 @@ using PlanarEngineGasForce = engine::planar::GasForce;
 /// The spatial model type of the bindings: every element type in it that describes itself can
 /// be added from Python (catalogue.hpp).
 using Model =
-    sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::Cylindrical,
-              sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane, sp::Orientation,
-              sp::ParallelAxes, sp::Perpendicular, sp::Gear, sp::RackPinion, sp::ScrewJoint,
-              sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity, sp::PointForce,
-              sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing, sp::SpherePlane, sp::SphereSphere,
-              sp::RevoluteLimit, sp::TranslationalLimit, sp::JointFriction, EngineGasForce,
-              UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
+    sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::CvJoint,
+              sp::Cylindrical, sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane,
+              sp::Orientation, sp::ParallelAxes, sp::Perpendicular, sp::Gear, sp::RackPinion,
+              sp::ScrewJoint, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
+              sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing, sp::SpherePlane,
+              sp::SphereSphere, sp::RevoluteLimit, sp::TranslationalLimit, sp::JointFriction,
+              EngineGasForce, UserForceT<Spatial, 1>, UserForceT<Spatial, 2>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
 using PlanarModel = pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,

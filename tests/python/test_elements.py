@@ -1,7 +1,9 @@
 """Every element type reachable from Python, each checked against a hand-computed or analytic
 value; Python callables checked against the same force computed in C++."""
 
+import importlib.util
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -93,6 +95,45 @@ def test_fixed_and_universal_hold_a_body_at_rest():
         if kind == "fixed":
             np.testing.assert_allclose(r.reaction("j", axes="joint").force[-1, 2], 3.0 * G,
                                        atol=1e-8)
+
+
+def _driveline_example():
+    path = pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" / "driveline.py"
+    spec = importlib.util.spec_from_file_location("driveline", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_cv_joint_turns_a_bent_output_shaft_at_the_input_speed():
+    # The constant-velocity joint turns b at omega at any bend, and the motor gives the load's
+    # torque (equal speeds: the power goes through). The Cardan joint's output speed swings as
+    # psi' = omega cos(beta) / (1 - sin^2(beta) cos^2(omega t)).
+    # The model is the driveline example's (examples/python/driveline.py).
+    covers("cv_joint")
+    example = _driveline_example()
+    beta, omega, load = 0.5, 3.0, 2.5
+    for joint in ("cv_joint", "universal"):
+        r = odyn.simulate(example.bent_driveline(joint, beta, omega, load), t_end=2.0,
+                          rtol=1e-10, atol=1e-10, output_interval=0.1)
+        spin = r.body("b").angular_velocity  # body axes: z is b's shaft
+        if joint == "cv_joint":
+            expected = np.full_like(r.t, omega)
+            np.testing.assert_allclose(r.reaction("motor").torque[:, 2], load, rtol=1e-8)
+            np.testing.assert_allclose(r.output("joint", "bend"), beta, atol=1e-10)
+        else:  # the closed form, written here again
+            c = np.cos(omega * r.t)
+            expected = omega * math.cos(beta) / (1 - math.sin(beta) ** 2 * c**2)
+        np.testing.assert_allclose(spin[:, 2], expected, atol=1e-8 * omega)
+        np.testing.assert_allclose(spin[:, :2], 0.0, atol=1e-8 * omega)
+
+
+def test_cv_joint_refuses_references_twisted_about_its_shafts():
+    m = odyn.Model()
+    m.add_body(name="b", mass=1.0, inertia=[0.1] * 3)
+    with pytest.raises(odyn.ModelError, match=r"'j'.*twisted by -?180"):
+        m.add_cv_joint(name="j", body_a="ground", on_a=odyn.frame([0, 0, 0], Z, X),
+                       body_b="b", on_b=odyn.frame([0, 0, 0], Z, [-1, 0, 0]))
 
 
 def test_distance_lets_a_horizontal_bob_fall_freely_at_first():

@@ -164,3 +164,14 @@ def test_andrews_twin_against_the_spec_and_the_test_set_reference(tmp_path):
     cpp = cpp_example("andrews", tmp_path)
     if cpp is not None:  # same model, same integrator
         np.testing.assert_allclose(data[:, 1:8], cpp[1][:, 1:8], rtol=1e-10)
+
+
+def test_driveline_example_prints_its_output_speeds():
+    # The test of the model itself is in test_elements.py; here the script runs as a user would.
+    run = subprocess.run([sys.executable, str(TWINS / "driveline.py"), "--bend", "30"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0].startswith("cv_joint : output speed 3.0000 to 3.0000 rad/s"), run.stdout
+    # cos(30 deg) and 1 / cos(30 deg) times the input speed 3.
+    assert lines[1].startswith("universal: output speed 2.5981 to 3.4641 rad/s"), run.stdout
