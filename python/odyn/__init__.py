@@ -35,7 +35,8 @@ from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBo
                       ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
 
-#: Every element type that Model.add accepts (and scenes, except user_force).
+#: Every element type that Model.add accepts (and scenes, except user_force and
+#: user_constraint).
 element_types = tuple(t for t in dict.fromkeys(_core.element_types) if t != "signal_watch")
 #: Every element type that PlanarModel.add accepts.
 planar_element_types = tuple(

@@ -624,6 +624,29 @@ class SpatialElements(_Adds):
             "user_force", name=name, bodies=bodies, function=function, jacobians=jacobians,
             difference_jacobians=difference_jacobians)
 
+    def add_user_constraint(
+            self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            jacobian: Optional[Callable[..., Any]] = None, gamma: Optional[Callable[...,
+            Any]] = None) -> str:
+        """One constraint equation written in Python on one or two bodies, phi(t, body_0[, body_1])
+        = 0 (ADAMS's GCON). 1 equation.
+
+        name: the element's name.
+        bodies: the one or two bodies it constrains.
+        function: function(t, body_0[, body_1]) -> phi, one number, zero where the constraint
+        holds.
+        jacobian: jacobian(t, body_0[, body_1]) -> the gradient of phi over the bodies' velocity
+        coordinates (6 per body in space: the centre globally, then a turn about the body's axes;
+        x, y, phi in the plane), then dphi/dt; checked once against differences (none: differences
+        of phi).
+        gamma: gamma(t, body_0[, body_1]) -> -(phi's second derivative along the motion at the
+        bodies' present velocities, kept constant in body axes); checked once against differences
+        (none: differences of phi).
+        """
+        return self._add_given(
+            "user_constraint", name=name, bodies=bodies, function=function, jacobian=jacobian,
+            gamma=gamma)
+
 
 class PlanarElements(_Adds):
     """The element types of odyn.PlanarModel, each added by its own method."""
@@ -1074,3 +1097,26 @@ class PlanarElements(_Adds):
         return self._add_given(
             "user_force", name=name, bodies=bodies, function=function, jacobians=jacobians,
             difference_jacobians=difference_jacobians)
+
+    def add_user_constraint(
+            self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
+            jacobian: Optional[Callable[..., Any]] = None, gamma: Optional[Callable[...,
+            Any]] = None) -> str:
+        """One constraint equation written in Python on one or two bodies, phi(t, body_0[, body_1])
+        = 0 (ADAMS's GCON). 1 equation.
+
+        name: the element's name.
+        bodies: the one or two bodies it constrains.
+        function: function(t, body_0[, body_1]) -> phi, one number, zero where the constraint
+        holds.
+        jacobian: jacobian(t, body_0[, body_1]) -> the gradient of phi over the bodies' velocity
+        coordinates (6 per body in space: the centre globally, then a turn about the body's axes;
+        x, y, phi in the plane), then dphi/dt; checked once against differences (none: differences
+        of phi).
+        gamma: gamma(t, body_0[, body_1]) -> -(phi's second derivative along the motion at the
+        bodies' present velocities, kept constant in body axes); checked once against differences
+        (none: differences of phi).
+        """
+        return self._add_given(
+            "user_constraint", name=name, bodies=bodies, function=function, jacobian=jacobian,
+            gamma=gamma)

@@ -52,10 +52,14 @@ from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, int
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
+#: Element types written in Python (functions), which a scene file cannot hold.
+PYTHON_ONLY = ("user_force", "user_constraint")
 #: Element types by section of a scene file, for each space.
-SPACE_SECTIONS = {space: {"joints": _schema.SPACE_JOINTS[space], "drivers": _schema.DRIVERS,
+SPACE_SECTIONS = {space: {"joints": tuple(t for t in _schema.SPACE_JOINTS[space]
+                                          if t not in PYTHON_ONLY),
+                          "drivers": _schema.DRIVERS,
                           "forces": tuple(t for t in _schema.SPACE_FORCES[space]
-                                          if t != "user_force")}
+                                          if t not in PYTHON_ONLY)}
                   for space in SPACES}
 SECTIONS = SPACE_SECTIONS["spatial"]
 TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "points",
@@ -120,9 +124,10 @@ class Scene:
         for section, kinds in SPACE_SECTIONS[self.model.space].items():
             entries = []
             for name, (kind, params, _) in self.model._elements.items():
-                if kind == "user_force" and section == "forces":
-                    fail(f"forces: '{name}'", "a user force is a Python function and cannot be "
-                         "saved in a scene file")
+                if kind in PYTHON_ONLY and section == "forces":
+                    fail(f"{'joints' if kind == 'user_constraint' else 'forces'}: '{name}'",
+                         f"a {kind.replace('_', ' ')} is a Python function and cannot be saved "
+                         "in a scene file")
                 if kind in kinds:
                     entries.append({"type": kind, **_plain(params, f"{section}: '{name}'")})
             out[section] = entries

@@ -266,6 +266,8 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
                     "the description lists state fields that state_values does not return");
       if constexpr (IsUserForce<E>::value)
         out.emplace(E::description.type, &add_user_force);
+      else if constexpr (IsUserConstraint<E>::value)
+        out.emplace(E::description.type, &add_user_constraint);
       else
         out.emplace(E::description.type, &add_described<E>);
     }
@@ -283,6 +285,31 @@ struct Catalogue<odyn::Model<Body, Elements...>> {
   struct IsUserForce : std::false_type {};
   template <class S, int N>
   struct IsUserForce<UserForceT<S, N>> : std::true_type {};
+
+  template <class E>
+  struct IsUserConstraint : std::false_type {};
+  template <class S>
+  struct IsUserConstraint<UserConstraintT<S>> : std::true_type {};
+
+  static void add_user_constraint(Box& box, const py::dict& values) {
+    using Space = typename ModelType::Space;
+    DictReader<ModelType> reader(box.model, values, UserConstraintT<Space>::description);
+    const auto name = parameter<std::string>(reader, "name");
+    std::vector<BodyId> bodies;
+    for (const std::string& body : reader.template get<std::vector<std::string>>("bodies"))
+      bodies.push_back(box.model.body(body));
+    std::array<py::object, 3> functions{reader.template get<py::object>("function"),
+                                        reader.template get<py::object>("jacobian"),
+                                        reader.template get<py::object>("gamma")};
+    reader.refuse_unread();
+    const std::string what = "user_constraint '" + name + "'";
+    std::array<std::shared_ptr<Callable<Space>>, 3> callables;
+    for (int i = 0; i < 3; ++i)
+      if (!functions[i].is_none())
+        callables[i] = std::make_shared<Callable<Space>>(std::move(functions[i]),
+                                                         static_cast<int>(bodies.size()), what);
+    box.model.add(UserConstraintT<Space>(name, bodies, callables[0], callables[1], callables[2]));
+  }
 
   /// A user force is compiled for one and for two bodies: the dict's body list picks.
   static void add_user_force(Box& box, const py::dict& values) {

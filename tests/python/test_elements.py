@@ -602,6 +602,10 @@ def test_joint_friction_is_covered_by_its_own_tests():
     covers("joint_friction")  # tests/python/test_joint_friction.py: closed forms
 
 
+def test_user_constraint_is_covered_by_its_own_tests():
+    covers("user_constraint")  # tests/python/test_user_constraint.py: closed forms, C++ distance
+
+
 def test_every_element_type_is_tested():
     # Runs last in this file (pytest keeps file order).
     assert set(odyn.element_types) == TESTED

@@ -270,6 +270,10 @@ def test_joint_friction_is_covered_by_its_own_tests():
     covers("joint_friction")  # tests/python/test_joint_friction.py: closed forms
 
 
+def test_user_constraint_is_covered_by_its_own_tests():
+    covers("user_constraint")  # tests/python/test_user_constraint.py: a slider on a sine
+
+
 def test_every_planar_element_type_is_tested():
     assert set(odyn.planar_element_types) == TESTED
     assert set(odyn.PlanarModel().element_types) == TESTED

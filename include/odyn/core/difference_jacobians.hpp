@@ -15,6 +15,19 @@
 
 namespace odyn {
 
+/// A body's configuration coordinates from its frame (Space::make_frame's inverse).
+template <class Space>
+typename Space::Configuration configuration_of(const typename Space::Frame& frame) {
+  typename Space::Configuration q;
+  if constexpr (requires { frame.angle; }) {
+    q << frame.position, frame.angle;
+  } else {
+    const Eigen::Quaterniond r(frame.rotation);
+    q << frame.position, r.w(), r.x(), r.y(), r.z();
+  }
+  return q;
+}
+
 /// Fills out.stiffness (-dQ/dq) and out.damping (-dQ/dv) of `element` at `in` by central
 /// differences; leaves out.force alone. Columns of the ground are zero (it does not move).
 template <StatelessForce E>
@@ -40,14 +53,8 @@ void difference_jacobians(const E& element, const InputOf<E>& in, ForceBlocksOf<
     if (element.bodies()[static_cast<std::size_t>(k)].is_ground()) continue;
     const Frame& start = in.body(k);
     Frame& frame = frames[static_cast<std::size_t>(k)];
-    typename Space::Configuration q;
+    const typename Space::Configuration q = configuration_of<Space>(start);
     typename Space::Velocity v;
-    if constexpr (requires { start.angle; }) {
-      q << start.position, start.angle;
-    } else {
-      const Eigen::Quaterniond r(start.rotation);
-      q << start.position, r.w(), r.x(), r.y(), r.z();
-    }
     v << start.linear_velocity, start.angular_velocity;
     // Steps scaled to the body's own sizes: its distance from the origin and its speed.
     const double h_position = 1e-6 * std::max(1.0, start.position.norm());
