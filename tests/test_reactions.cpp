@@ -4,9 +4,12 @@
 // so that every frame transformation in odyn::reaction is exercised.
 
 #include <Eigen/Geometry>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <odyn/odyn.hpp>
@@ -56,7 +59,54 @@ void check_action_reaction(const Model& model, const Workspace& ws, odyn::Handle
   check_vector(on_a.torque, -on_b.torque, scale);
 }
 
+/// A constraint on one body only, as a downstream element might be: its centre stays at height
+/// h (z = h). 1 equation.
+class AtHeight {
+ public:
+  using Space = odyn::Spatial;
+  using Input = odyn::ElementInput<Space, 1>;
+  static constexpr int num_bodies = 1;
+  static constexpr int num_equations = 1;
+  AtHeight(std::string name, BodyId body, double height)
+      : name_(std::move(name)), bodies_{body}, height_(height) {}
+  const std::string& name() const { return name_; }
+  const std::array<BodyId, 1>& bodies() const { return bodies_; }
+  void evaluate(const Input& in, odyn::ConstraintBlocks<Space, 1, 1>& out) const {
+    out.phi[0] = in.body(0).position.z() - height_;
+    out.jacobian[0].setZero();
+    out.jacobian[0](0, 2) = 1.0;
+    out.phi_t.setZero();
+  }
+  Eigen::Matrix<double, 1, 1> gamma(const Input&) const { return Eigen::Matrix<double, 1, 1>(0.0); }
+
+ private:
+  std::string name_;
+  std::array<BodyId, 1> bodies_;
+  double height_;
+};
+
 }  // namespace
+
+TEST_CASE("A constraint on one body: its reaction on side a, none on side b", "[reactions]") {
+  // A 2 kg body held at z = 0.3 under gravity: the constraint pushes it up with m g.
+  sp::Model<AtHeight, sp::Gravity> model;
+  sp::Body body{.name = "block", .mass = 2.0, .inertia = sp::Body::principal(0.1, 0.2, 0.3)};
+  body.position = Vector3d(0.1, -0.2, 0.3);
+  body.orientation = tilted();
+  const BodyId b = model.add_body(body);
+  const auto held = model.add(AtHeight("held", b, 0.3));
+  model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
+  odyn::Workspace<decltype(model)> ws(model);
+  odyn::assemble(model, ws);
+  const auto on_body = odyn::reaction(model, ws, held, Side::a);
+  CHECK((on_body.force - Vector3d(0.0, 0.0, 2.0 * g)).norm() < 1e-12);
+  CHECK(on_body.torque.norm() < 1e-12);
+  for (const ReactionAxes axes : {ReactionAxes::global, ReactionAxes::joint}) {
+    const auto none = odyn::reaction(model, ws, held, Side::b, axes);
+    CHECK(none.force.norm() == 0.0);
+    CHECK(none.torque.norm() == 0.0);
+  }
+}
 
 TEST_CASE("Statically determined beam: hinge and inclined rod", "[reactions]") {
   // A uniform beam (mass m, length L) along global x from the hinge at the origin (axis global

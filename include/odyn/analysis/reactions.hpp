@@ -12,7 +12,8 @@ namespace odyn {
 
 enum class ReactionAxes { global, joint };
 
-/// Side of a joint: the reaction on body a (exerted by b) or on body b (exerted by a).
+/// Side of a joint: the reaction on body a (exerted by b) or on body b (exerted by a). A
+/// constraint on one body has only side a; its side b reads zero.
 enum class Side { a = 0, b = 1 };
 
 /// A joint that says where it sits on each body (side 0 = a, 1 = b) and, in global
@@ -31,6 +32,8 @@ typename Model::Space::Wrench reaction(const Model& model, const Workspace<Model
                                        ReactionAxes axes = ReactionAxes::global) {
   using Space = typename Model::Space;
   const int k = static_cast<int>(side);
+  // A constraint on one body (a point held on a fixed surface) has no side b: nothing acts there.
+  if (k >= E::num_bodies) return {};
   const E& element = model.element(handle);
   const auto& blocks = std::get<Model::template type_index<E>>(ws.blocks)[handle.index];
   const auto lambda = ws.lambda.template segment<E::num_equations>(model.row(handle));
