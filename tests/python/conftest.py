@@ -1,6 +1,7 @@
 """Shared fixtures: paths of the repository, the engine scene and the C++ engine example."""
 
 import csv
+import importlib.util
 import pathlib
 import shutil
 import subprocess
@@ -9,6 +10,15 @@ import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def python_example(name):
+    """examples/python/<name>.py imported as a module (its model builders and helpers)."""
+    path = ROOT / "examples" / "python" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 ENGINE_SCENE = ROOT / "examples" / "engine.json"
 
 

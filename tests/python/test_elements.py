@@ -1,14 +1,13 @@
 """Every element type reachable from Python, each checked against a hand-computed or analytic
 value; Python callables checked against the same force computed in C++."""
 
-import importlib.util
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
 import odyn
+from conftest import python_example
 
 G = 9.81
 X, Y, Z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
@@ -97,21 +96,13 @@ def test_fixed_and_universal_hold_a_body_at_rest():
                                        atol=1e-8)
 
 
-def _driveline_example():
-    path = pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" / "driveline.py"
-    spec = importlib.util.spec_from_file_location("driveline", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_cv_joint_turns_a_bent_output_shaft_at_the_input_speed():
     # The constant-velocity joint turns b at omega at any bend, and the motor gives the load's
     # torque (equal speeds: the power goes through). The Cardan joint's output speed swings as
     # psi' = omega cos(beta) / (1 - sin^2(beta) cos^2(omega t)).
     # The model is the driveline example's (examples/python/driveline.py).
     covers("cv_joint")
-    example = _driveline_example()
+    example = python_example("driveline")
     beta, omega, load = 0.5, 3.0, 2.5
     for joint in ("cv_joint", "universal"):
         r = odyn.simulate(example.bent_driveline(joint, beta, omega, load), t_end=2.0,

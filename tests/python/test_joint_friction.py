@@ -4,14 +4,13 @@ v_t atanh(tan / mu_s), in space and in the plane; a pendulum's energy falls by t
 its pin friction's power output; a block on a moving belt sticks and slips with the period of
 Coulomb's law as the Stribeck velocity falls; scene round trips; bad input refused by name."""
 
-import importlib.util
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
 import odyn
+from conftest import python_example
 
 G = 9.81
 MU, MU_S = 0.5, 0.6
@@ -187,19 +186,11 @@ def test_a_friction_that_feeds_itself_without_bound_is_refused_by_name():
         odyn.simulate(tall_slider(0.1), t_end=0.2, output_interval=0.1, integrator="dop853")
 
 
-def _stick_slip_example():
-    path = pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" / "stick_slip.py"
-    spec = importlib.util.spec_from_file_location("stick_slip", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_a_block_on_a_belt_sticks_and_slips_with_coulombs_period():
     """The friction between two moving bodies (a driven belt and a block held by a spring):
     the limit cycle's period and the block's farthest reach approach Coulomb's closed forms as
     the Stribeck velocity v_s falls (v_t = v_s / 100)."""
-    example = _stick_slip_example()
+    example = python_example("stick_slip")
     k, mass, mu, mu_s, speed = 100.0, 1.0, 0.4, 0.6, 0.05
     omega, gap = math.sqrt(k / mass), (mu_s - mu) * mass * G / k
     reach = mu * mass * G / k + math.hypot(gap, speed / omega)  # the slip's swing
