@@ -74,14 +74,23 @@ configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" 
 cmake --build build-asan -j "$jobs"
 
 section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
+asan_rc=0
 (
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
   ctest --test-dir build-asan --output-on-failure
-)
+) || asan_rc=$?
 # The sanitizer run is the longest step of CI: name the cases that cost it most.
 echo "Slowest cases under the sanitizers (seconds):"
 grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log | sort -rn | head -n 12 || true
+if ((asan_rc != 0)); then
+  # The run's log (every case with its time) is long enough to be cut where CI shows only its
+  # ends: repeat the failures last, without the timings.
+  section "The sanitizer run's failures, again"
+  grep -vE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log |
+    grep -B 14 -A 16 -E 'FAILED:|ERROR: AddressSanitizer|runtime error:' | tail -n 200 || true
+  exit "$asan_rc"
+fi
 
 section "Release examples, install + downstream find_package(odyn)"
 finish "$release_pid" "$release_log" "the Release examples or the downstream build"

@@ -222,7 +222,7 @@ TEST_CASE("A gear pair turns as one inertia, for many turns", "[gears]") {
         const auto b = model.add_body(
             pl::Body{.name = "b", .mass = 1.0, .inertia = inertia_b, .position = {0.3, 0.0}});
         const pl::Revolute hinge_a("hinge_a", odyn::ground, {}, a, {});
-        const pl::Revolute hinge_b("hinge_b", odyn::ground, {Vector2d(0.3, 0.0), {}}, b, {});
+        const pl::Revolute hinge_b("hinge_b", odyn::ground, {Vector2d(0.3, 0.0)}, b, {});
         model.add(hinge_a);
         model.add(hinge_b);
         model.add(pl::Gear("mesh", hinge_a, hinge_b, ratio));

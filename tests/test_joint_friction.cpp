@@ -293,7 +293,7 @@ TEST_CASE("A pendulum with a rubbing pin loses its swing as its pin's reaction s
                                 .inertia = inertia,
                                 .position = length * Vector2d(std::sin(theta0), -std::cos(theta0)),
                                 .angle = theta0});
-    model.add(pl::Revolute("pin", odyn::ground, {}, body, {Vector2d(0.0, length), {}}));
+    model.add(pl::Revolute("pin", odyn::ground, {}, body, {Vector2d(0.0, length)}));
     model.add(pl::JointFriction("rubbing", "pin", friction));
     model.add(pl::Gravity("gravity", Vector2d(0.0, -g)));
     odyn::Workspace<pl::DefaultModel> ws(model);

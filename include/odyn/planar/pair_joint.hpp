@@ -29,7 +29,8 @@ namespace odyn::planar {
 /// A joint's point and axis on one body, in body coordinates.
 struct JointFrame {
   Eigen::Vector2d point = Eigen::Vector2d::Zero();
-  /// Zero vector: parallel to the other body's axis at the initial pose.
+  /// Zero vector: parallel to the other body's axis at the initial pose. To leave it out,
+  /// leave the member out ({point}): an Eigen vector written {} is not zero but uninitialized.
   Eigen::Vector2d axis = Eigen::Vector2d::Zero();
 };
 

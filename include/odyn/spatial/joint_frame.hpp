@@ -16,7 +16,8 @@ namespace odyn::spatial {
 struct JointFrame {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
-  /// Zero vector: chosen from the other body's reference at the initial pose.
+  /// Zero vector: chosen from the other body's reference at the initial pose. To leave it out,
+  /// leave the member out ({point, axis}): an Eigen vector written {} is uninitialized.
   Eigen::Vector3d reference = Eigen::Vector3d::Zero();
 };
 
