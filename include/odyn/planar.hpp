@@ -28,6 +28,8 @@ using PointTorque = PointTorqueT<Planar>;
 using Tsda = TsdaT<Planar>;
 using CircleLine = SpherePlaneT<Planar>;
 using CircleCircle = SphereSphereT<Planar>;
+using RectangleLine = BoxPlaneT<Planar>;
+using CapsuleLine = CapsulePlaneT<Planar>;
 using Gear = GearT<PairJoint, JointFrame>;
 using RackPinion = RackPinionT<PairJoint, JointFrame>;
 using JointFriction = JointFrictionT<PairJoint>;
@@ -41,9 +43,9 @@ template <class... Elements>
 using Model = odyn::Model<Body, Elements...>;
 
 /// Every planar element type of the library (what scripting uses).
-using DefaultModel =
-    Model<Revolute, Translational, Fixed, Distance, InLine, Gear, RackPinion, RevoluteDriver,
-          TranslationalDriver, Gravity, PointForce, PointTorque, Tsda, Rsda, Bushing, CircleLine,
-          CircleCircle, RevoluteLimit, TranslationalLimit, JointFriction>;
+using DefaultModel = Model<Revolute, Translational, Fixed, Distance, InLine, Gear, RackPinion,
+                           RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque,
+                           Tsda, Rsda, Bushing, CircleLine, CircleCircle, RectangleLine,
+                           CapsuleLine, RevoluteLimit, TranslationalLimit, JointFriction>;
 
 }  // namespace odyn::planar

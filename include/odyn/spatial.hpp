@@ -31,6 +31,8 @@ using PointTorque = PointTorqueT<Spatial>;
 using Tsda = TsdaT<Spatial>;
 using SpherePlane = SpherePlaneT<Spatial>;
 using SphereSphere = SphereSphereT<Spatial>;
+using BoxPlane = BoxPlaneT<Spatial>;
+using CapsulePlane = CapsulePlaneT<Spatial>;
 using Gear = GearT<PairJoint, JointFrame>;
 using RackPinion = RackPinionT<PairJoint, JointFrame>;
 using JointFriction = JointFrictionT<PairJoint>;
@@ -48,7 +50,7 @@ using DefaultModel =
     Model<Revolute, Translational, Spherical, Universal, CvJoint, Cylindrical, Fixed, Distance,
           PlanarJoint, InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion,
           ScrewJoint, RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda,
-          Rsda, Bushing, SpherePlane, SphereSphere, RevoluteLimit, TranslationalLimit,
-          JointFriction>;
+          Rsda, Bushing, SpherePlane, SphereSphere, BoxPlane, CapsulePlane, RevoluteLimit,
+          TranslationalLimit, JointFriction>;
 
 }  // namespace odyn::spatial

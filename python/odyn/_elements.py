@@ -486,6 +486,71 @@ class SpatialElements(_Adds):
             center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
             exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
 
+    def add_box_plane(
+            self, name: str, body_a: str, body_b: str, half_extents: Vector, *,
+            center_b: Vector = (0, 0, 0), point: Vector = (0, 0, 0), normal: Vector = (0, 0, 1),
+            stiffness: float, exponent: float = 1.5, dissipation: float = 0.0,
+            friction: float = 0.0, slip_speed: float = 0.001) -> str:
+        """Compliant contact of a box on b with a plane on a, at the box's corners: Hunt-Crossley
+        normal force k delta^n (1 + d delta') and regularized Coulomb friction at each corner
+        inside the plane.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the solid.
+        half_extents (m): half the box's (rectangle's) edge lengths along b's axes.
+        center_b (m): the box's (rectangle's) centre, in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N), points.
+        """
+        return self._add_given(
+            "box_plane", name=name, body_a=body_a, body_b=body_b, half_extents=half_extents,
+            center_b=center_b, point=point, normal=normal, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_capsule_plane(
+            self, name: str, body_a: str, body_b: str, radius_b: float, half_length: float, *,
+            axis_b: Vector = (0, 0, 1), center_b: Vector = (0, 0, 0), point: Vector = (0, 0, 0),
+            normal: Vector = (0, 0, 1), stiffness: float, exponent: float = 1.5,
+            dissipation: float = 0.0, friction: float = 0.0, slip_speed: float = 0.001) -> str:
+        """Compliant contact of a capsule on b with a plane on a, at its end spheres: Hunt-Crossley
+        normal force k delta^n (1 + d delta') and regularized Coulomb friction at each end inside
+        the plane.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the solid.
+        radius_b (m): the capsule's radius.
+        half_length (m): half the distance between the end spheres' (circles') centres.
+        axis_b: the capsule's axis, in b's coordinates.
+        center_b (m): the capsule's centre, in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N), points.
+        """
+        return self._add_given(
+            "capsule_plane", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            half_length=half_length, axis_b=axis_b, center_b=center_b, point=point, normal=normal,
+            stiffness=stiffness, exponent=exponent, dissipation=dissipation, friction=friction,
+            slip_speed=slip_speed)
+
     def add_revolute_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
@@ -959,6 +1024,71 @@ class PlanarElements(_Adds):
             "circle_circle", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
             center_b=center_b, radius_a=radius_a, center_a=center_a, stiffness=stiffness,
             exponent=exponent, dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_rectangle_line(
+            self, name: str, body_a: str, body_b: str, half_extents: Vector, *,
+            center_b: Vector = (0, 0), point: Vector = (0, 0), normal: Vector = (0, 1),
+            stiffness: float, exponent: float = 1.5, dissipation: float = 0.0,
+            friction: float = 0.0, slip_speed: float = 0.001) -> str:
+        """Compliant contact of a rectangle on b with a line on a, at the rectangle's corners:
+        Hunt-Crossley normal force k delta^n (1 + d delta') and regularized Coulomb friction at
+        each corner inside the line.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the solid.
+        half_extents (m): half the box's (rectangle's) edge lengths along b's axes.
+        center_b (m): the box's (rectangle's) centre, in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N), points.
+        """
+        return self._add_given(
+            "rectangle_line", name=name, body_a=body_a, body_b=body_b, half_extents=half_extents,
+            center_b=center_b, point=point, normal=normal, stiffness=stiffness, exponent=exponent,
+            dissipation=dissipation, friction=friction, slip_speed=slip_speed)
+
+    def add_capsule_line(
+            self, name: str, body_a: str, body_b: str, radius_b: float, half_length: float, *,
+            axis_b: Vector = (1, 0), center_b: Vector = (0, 0), point: Vector = (0, 0),
+            normal: Vector = (0, 1), stiffness: float, exponent: float = 1.5,
+            dissipation: float = 0.0, friction: float = 0.0, slip_speed: float = 0.001) -> str:
+        """Compliant contact of a capsule (a stadium) on b with a line on a, at its end circles:
+        Hunt-Crossley normal force k delta^n (1 + d delta') and regularized Coulomb friction at
+        each end inside the line.
+
+        name: the element's name.
+        body_a: the body with the plane or the first sphere.
+        body_b: the body with the solid.
+        radius_b (m): the capsule's radius.
+        half_length (m): half the distance between the end spheres' (circles') centres.
+        axis_b: the capsule's axis, in b's coordinates.
+        center_b (m): the capsule's centre, in b's coordinates.
+        point (m): a point of the plane (line) on body a, in a's coordinates.
+        normal: the plane's (line's) outward normal, in a's coordinates; b's side of a.
+        stiffness (N/m^n): k: the normal force is k delta^n at rest.
+        exponent: n >= 1 (1.5: Hertz's, for spheres).
+        dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
+        an impact speed v, odyn.hunt_crossley_dissipation(e, v).
+        friction: mu, the Coulomb friction coefficient.
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+
+        Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
+        friction_force (N), points.
+        """
+        return self._add_given(
+            "capsule_line", name=name, body_a=body_a, body_b=body_b, radius_b=radius_b,
+            half_length=half_length, axis_b=axis_b, center_b=center_b, point=point, normal=normal,
+            stiffness=stiffness, exponent=exponent, dissipation=dissipation, friction=friction,
+            slip_speed=slip_speed)
 
     def add_revolute_limit(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,

@@ -2,7 +2,11 @@
 circle_circle), against closed forms: the Hunt-Crossley law's restitution from its first
 integral, a ball rolling down an incline (5/7 g sin(theta); a disc 2/3) and one sliding on it
 (g (sin(theta) - mu cos(theta))), momentum in a collision of two free balls, and a bouncing ball
-under the default integrator against a converged dop853 run; bad parameters refused by name."""
+under the default integrator against a converged dop853 run; bad parameters refused by name.
+Boxes and capsules (box_plane, capsule_plane, rectangle_line, capsule_line): a tall box on a
+rough slope stands below its tipping angle atan(w / h) and tips over above it, a box settles at
+its static sinking (m g / (4 k))^(1/n), and a planar capsule rolls down a slope like a disc
+where its end circle touches."""
 
 import json
 import math
@@ -271,3 +275,93 @@ def test_a_contact_in_a_scene_file_with_its_touchdown_as_an_event(tmp_path):
     path.write_text(json.dumps(saved))
     with pytest.raises(odyn.SceneError, match="radius"):
         odyn.load(str(path))
+
+
+@pytest.mark.parametrize("beyond", [-0.04, 0.04])
+def test_a_tall_box_on_a_rough_slope_tips_over_beyond_atan_of_its_width_over_its_height(beyond):
+    """Statics: a box of half width w and half height h held from sliding (mu > tan(theta))
+    tips about its lower edge once its weight's line passes that edge, at tan(theta) = w / h.
+    The slope is the plane z = 0 under a gravity tilted by theta along x."""
+    w, depth, h, mass, k = 0.1, 0.2, 0.3, 2.0, 1e6
+    theta = math.atan(w / h) + beyond
+    inertia = mass / 3 * np.array([depth ** 2 + h ** 2, w ** 2 + h ** 2, w ** 2 + depth ** 2])
+    m = odyn.Model()
+    sinking = mass * G * math.cos(theta) / (4 * k)
+    m.add_body("box", mass, inertia, position=[0.0, 0.0, h - sinking])
+    m.add_gravity("gravity", [G * math.sin(theta), 0.0, -G * math.cos(theta)])
+    m.add_box_plane("slope", "ground", "box", [w, depth, h], stiffness=k, exponent=1.0,
+                    dissipation=50.0, friction=0.8)
+    r = odyn.simulate(m, t_end=1.0, output_interval=0.01)
+    q = r.body("box").orientation
+    pitch = 2 * np.arctan2(q[:, 2], q[:, 0])  # about y: the box turns about its edge along y
+    points = r.output("slope", "points")
+    if beyond < 0:
+        assert np.abs(pitch).max() < 1e-3 and points[-1] == 4
+        assert r.output("slope", "normal_force")[-1] == pytest.approx(
+            mass * G * math.cos(theta), rel=1e-4)
+    else:
+        assert pitch[-1] > 0.5 and points.min() <= 2
+
+
+@pytest.mark.parametrize("space", ["spatial", "planar"])
+def test_a_box_settles_at_its_static_sinking_on_its_corners(space):
+    """Dropped flat from 1 cm with dissipation, it comes to rest on all its corners, sunk by
+    (m g / (c k))^(1/n) with c corners; the gap output is minus that."""
+    mass, k, n = 3.0, 2e6, 1.5
+    if space == "spatial":
+        m = odyn.Model()
+        m.add_body("box", mass, [0.05, 0.06, 0.07], position=[0.0, 0.0, 0.11])
+        m.add_gravity("gravity", [0.0, 0.0, -G])
+        m.add_box_plane("floor", "ground", "box", [0.2, 0.15, 0.1], stiffness=k, exponent=n,
+                        dissipation=20.0, friction=0.5)
+        corners = 4
+    else:
+        m = odyn.PlanarModel()
+        m.add_body("box", mass, 0.05, position=[0.0, 0.11])
+        m.add_gravity("gravity", [0.0, -G])
+        m.add_rectangle_line("floor", "ground", "box", [0.2, 0.1], stiffness=k, exponent=n,
+                             dissipation=20.0, friction=0.5)
+        corners = 2
+    r = odyn.simulate(m, t_end=1.5, output_interval=0.5)
+    sinking = (mass * G / (corners * k)) ** (1 / n)
+    assert r.output("floor", "points")[-1] == corners
+    assert r.output("floor", "gap")[-1] == pytest.approx(-sinking, rel=1e-4)
+    assert r.output("floor", "normal_force")[-1] == pytest.approx(mass * G, rel=1e-5)
+
+
+def test_a_capsule_in_a_scene_file_lands_at_the_free_falls_time(tmp_path):
+    """A capsule lying level 0.25 m above the floor touches down at sqrt(2 h / g) (an event on
+    the element's gap), from a saved scene; a key the capsule does not have is refused."""
+    m = odyn.Model()
+    m.add_body("rod", 1.0, [0.01, 0.01, 0.002], position=[0.0, 0.0, 0.3])
+    m.add_gravity("g", [0, 0, -G])
+    m.add_capsule_plane("floor", "ground", "rod", 0.05, half_length=0.2, axis_b=[1, 0, 0],
+                        stiffness=1e6, dissipation=0.5)
+    m.add_event("touch", output=("floor", "gap"), direction="falling")
+    path = tmp_path / "rod.json"
+    odyn.save(odyn.Scene(m, {"t_end": 0.4, "output_interval": 0.01, "integrator": "dop853",
+                             "rtol": 1e-10, "atol": 1e-12}), str(path))
+    saved = json.loads(path.read_text())
+    (floor,) = [f for f in saved["forces"] if f["name"] == "floor"]
+    assert floor["type"] == "capsule_plane" and floor["half_length"] == 0.2
+    r = odyn.load(str(path)).simulate()
+    assert r.event_times("touch")[0] == pytest.approx(math.sqrt(2 * 0.25 / G), abs=1e-9)
+    assert r.output("floor", "points").max() == 2
+    floor["half_extents"] = [0.1, 0.1, 0.1]
+    path.write_text(json.dumps(saved))
+    with pytest.raises(odyn.SceneError, match="half_extents"):
+        odyn.load(str(path))
+
+
+def test_bad_box_and_capsule_parameters_are_refused_by_name():
+    m = odyn.Model()
+    m.add_body("box", 1.0, [0.1, 0.1, 0.1])
+    with pytest.raises(odyn.ModelError, match="lid: half_extents"):
+        m.add_box_plane("lid", "ground", "box", [0.1, -0.1, 0.1], stiffness=1e6)
+    with pytest.raises(odyn.ModelError, match="'rod'.half_length: expected a positive number"):
+        m.add_capsule_plane("rod", "ground", "box", 0.05, half_length=0.0, stiffness=1e6)
+    with pytest.raises(odyn.ModelError, match="rod: axis_b"):
+        m.add_capsule_plane("rod", "ground", "box", 0.05, half_length=0.2, axis_b=[0, 0, 0],
+                            stiffness=1e6)
+    with pytest.raises(TypeError):
+        m.add_box_plane("lid", "ground", "box", [0.1, 0.1, 0.1], stiffness=1e6, radius_b=0.1)

@@ -578,7 +578,7 @@ def test_engine_gas_force_is_covered_by_the_engine_tests():
 
 
 def test_contacts_are_covered_by_their_own_tests():
-    covers("sphere_plane", "sphere_sphere")  # tests/python/test_contact.py: closed forms
+    covers("sphere_plane", "sphere_sphere", "box_plane", "capsule_plane")  # test_contact.py
 
 
 def test_stops_are_covered_by_their_own_tests():

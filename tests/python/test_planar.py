@@ -255,7 +255,7 @@ def test_bushing_mount_modes_and_a_scene():
 
 
 def test_contacts_are_covered_by_their_own_tests():
-    covers("circle_line", "circle_circle")  # tests/python/test_contact.py: closed forms
+    covers("circle_line", "circle_circle", "rectangle_line", "capsule_line")  # test_contact.py
 
 
 def test_stops_are_covered_by_their_own_tests():
