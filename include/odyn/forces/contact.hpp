@@ -2,7 +2,7 @@
 // Compliant contact between a sphere on body b and a plane or another sphere on body a (in the
 // plane: a circle, and a line or a circle), and between a box or a capsule on b and a plane on
 // a. A box touches at its corners and a capsule at its end spheres: a plane meets a convex
-// solid deepest at one of those points, and each point that is in touches by the law below
+// solid deepest at one of those points, and each point past the plane pushes by the law below
 // (as MuJoCo's box-plane and capsule-plane pairs do). Where the gap g between the surfaces is
 // negative, the penetration delta = -g and its rate delta' give the Hunt-Crossley normal force
 //   F_n = k delta^n (1 + d delta'),  kept >= 0 (no pull as the bodies separate),
