@@ -19,6 +19,8 @@ def python_example(name):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
 ENGINE_SCENE = ROOT / "examples" / "engine.json"
 
 
