@@ -36,6 +36,11 @@ class InventedValues {
       return k == "C" ? 9.0 : k == "L" ? 0.5 : k == "exponent" ? 1.5 : 0.25;
     } else if constexpr (std::is_same_v<T, std::optional<double>>) {
       return k == "lower" ? -0.25 : 0.25;  // a stop's limits, lower below upper
+    } else if constexpr (std::is_same_v<T, odyn::JointCoordinateKind> ||
+                         std::is_same_v<T, std::optional<odyn::JointCoordinateKind>>) {
+      return odyn::JointCoordinateKind::angle;  // a coupler's coordinates
+    } else if constexpr (requires(typename T::value_type joint) { joint.on_a, joint.body_b; }) {
+      return typename T::value_type{odyn::BodyId{2}, {}, odyn::BodyId{3}, {}};  // joint_3
     } else if constexpr (std::is_same_v<T, odyn::BodyId>) {
       return odyn::BodyId{k == "body_b" || k == "piston" ? 2 : 1};
     } else if constexpr (std::is_same_v<T, odyn::Axes>) {
@@ -52,8 +57,10 @@ class InventedValues {
       frame.point = k == "on_a" ? Eigen::Vector2d(0.1, 0.2) : Eigen::Vector2d(-0.3, 0.4);
       return frame;
     } else if constexpr (requires(T joint) { joint.on_a, joint.body_b; }) {
-      // A joint a gear or a rack names: bodies 1 and 2 for the first, 1 and 3 for the second.
-      return T{odyn::BodyId{1}, {}, odyn::BodyId{k == "joint_a" || k == "pinion" ? 2 : 3}, {}};
+      // A joint a gear, a rack or a coupler names: bodies 1 and 2 for the first, 1 and 3 for
+      // the second.
+      const bool first = k == "joint_a" || k == "pinion" || k == "joint_1";
+      return T{odyn::BodyId{1}, {}, odyn::BodyId{first ? 2 : 3}, {}};
     } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
       return k == "point_b" ? Eigen::Vector3d(-0.3, 0.0, 0.4) : Eigen::Vector3d(0.1, 0.2, 0.3);
     } else if constexpr (std::is_same_v<T, Eigen::Vector2d>) {

@@ -8,7 +8,10 @@
 //   coordinates, with dop853 and generalized-alpha, its mesh passing I_a accel - T to gear a;
 // - a pushed rack drives its pinion at s = r theta with (m + I / r^2) s'' = F;
 // - a nut on a vertical lead screw sinks under gravity at g m / (m + I (2 pi / p)^2);
-// - zero ratios, radii and pitches are refused by name.
+// - a planetary gear set built from two three-joint couplers (the sun's and the ring's meshes
+//   with the planet, as seen from the carrier) against its Lagrangian in two coordinates, the
+//   sun's and the ring's angles: Willis's relation follows, it is not put in;
+// - zero ratios, radii, pitches and scales are refused by name.
 
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
@@ -129,7 +132,7 @@ void check_blocks(E element, Poses poses) {
   odyn::BlocksOf<E> later;
   element.evaluate(input_of(element, poses), turned, later);
   double expected = 0.0;
-  for (int i = 0; i < 2; ++i)
+  for (int i = 0; i < element.count(); ++i)
     if (element.term(i).kind == odyn::JointCoordinateKind::angle)
       expected += element.term(i).coefficient * 6.0 * pi;
   CHECK(later.phi[0] - blocks.phi[0] == Approx(expected).margin(1e-9));
@@ -152,6 +155,17 @@ TEST_CASE("Couplings' Jacobians and gamma are their Phi's derivatives", "[gears]
     const sp::Revolute pinion("pinion", odyn::BodyId{1}, frame(), odyn::BodyId{2}, frame());
     const sp::Translational rack("rack", odyn::ground, frame(), odyn::BodyId{3}, frame());
     check_blocks(sp::RackPinion("drive", pinion, rack, 0.05), poses);
+  }
+  SECTION("a coupler of three joints, two of them sharing a body, one a slide") {
+    const sp::Revolute planet("planet", odyn::BodyId{1}, frame(), odyn::BodyId{2}, frame());
+    const sp::Cylindrical sun("sun", odyn::ground, frame(), odyn::BodyId{3}, frame());
+    const sp::Revolute carrier("carrier", odyn::ground, frame(), odyn::BodyId{1}, frame());
+    using Coordinate = sp::Coupler::Coordinate;
+    const sp::Coupler coupler("mesh", Coordinate{planet, odyn::JointCoordinateKind::angle, 18.0},
+                              Coordinate{sun, odyn::JointCoordinateKind::slide, 240.0},
+                              Coordinate{carrier, odyn::JointCoordinateKind::angle, -24.0});
+    CHECK(coupler.bodies()[5].is_ground());  // the carrier takes one slot
+    check_blocks(coupler, poses);
   }
   SECTION("a screw") {
     check_blocks(sp::ScrewJoint("lead", odyn::BodyId{2}, frame(), odyn::BodyId{3}, frame(), 0.004),
@@ -316,7 +330,151 @@ TEST_CASE("A nut sinks down a lead screw", "[gears]") {
   }
 }
 
-TEST_CASE("Zero ratios, radii and pitches are refused by name", "[gears]") {
+/// A planetary gear set: sun, ring and carrier on hinges about one axis, one planet on the carrier
+/// at the pitch radius r_s + r_p. Its two meshes, as the carrier sees them, are couplers of three
+/// joint angles (phi the planet's on the carrier):
+///   Z_p phi + Z_s (theta_s - theta_c) = 0,   Z_p phi - Z_r (theta_r - theta_c) = 0.
+/// Torques on the sun and the carrier, none on the ring.
+struct Planetary {
+  static constexpr double teeth_sun = 24, teeth_planet = 18, teeth_ring = 60, module = 0.002;
+  static constexpr double radius = module * (teeth_sun + teeth_planet) / 2;  // the planet's
+  static constexpr double inertia_sun = 0.002, inertia_ring = 0.03, inertia_carrier = 0.01;
+  static constexpr double planet_mass = 0.4, inertia_planet = 8e-4;
+  static constexpr double torque_sun = 0.05, torque_carrier = -0.03;
+
+  /// The angular velocities (sun, ring, carrier, planet in the ground, planet on the carrier)
+  /// from the sun's and the ring's: the meshes solved for the others.
+  static Eigen::Matrix<double, 5, 2> velocities() {
+    const double c_s = teeth_sun / (teeth_sun + teeth_ring), c_r = 1.0 - c_s;
+    Eigen::Matrix<double, 5, 2> a;
+    a.row(0) << 1.0, 0.0;
+    a.row(1) << 0.0, 1.0;
+    a.row(2) << c_s, c_r;
+    a.row(4) = -teeth_sun / teeth_planet * (a.row(0) - a.row(2));
+    a.row(3) = a.row(2) + a.row(4);
+    return a;
+  }
+  /// theta_s'' and theta_r'' from Lagrange's equations in those two coordinates.
+  static Eigen::Vector2d accelerations() {
+    const Eigen::Matrix<double, 5, 2> a = velocities();
+    Eigen::Matrix<double, 5, 1> inertia, torque;
+    inertia << inertia_sun, inertia_ring, inertia_carrier + planet_mass * radius * radius,
+        inertia_planet, 0.0;
+    torque << torque_sun, 0.0, torque_carrier, 0.0, 0.0;
+    const Eigen::Matrix2d mass = a.transpose() * inertia.asDiagonal() * a;
+    return mass.ldlt().solve(a.transpose() * torque);
+  }
+};
+
+TEST_CASE("A planetary gear set of couplers keeps Willis's relation", "[gears]") {
+  using P = Planetary;
+  const double t_end = 1.5;
+  const Eigen::Vector2d accel = P::accelerations();
+  const Eigen::Matrix<double, 5, 1> angles = P::velocities() * (0.5 * accel * t_end * t_end);
+  // Over 1.5 s the sun and the planet on the carrier turn about 2.4 times each.
+  CHECK(std::abs(angles[0]) > 4 * pi);
+  CHECK(std::abs(angles[4]) > 3 * pi);
+  // Willis: (theta_s - theta_c) / (theta_r - theta_c) = -Z_r / Z_s.
+  CHECK((angles[0] - angles[2]) / (angles[1] - angles[2]) ==
+        Approx(-P::teeth_ring / P::teeth_sun).epsilon(1e-12));
+  for (const char* integrator : {"dop853", "generalized-alpha"}) {
+    for (const char* coordinates : {"absolute", "joint"}) {
+      const odyn::DynamicsSettings s = settings_for(integrator, coordinates, t_end);
+      const double tolerance = s.integrator == "dop853" ? 1e-8 : 1e-5;
+      SECTION(std::string("in space, ") + integrator + ", " + coordinates) {
+        sp::DefaultModel model;
+        const Vector3d axis = Vector3d(2.0, -1.0, 2.0) / 3.0;
+        const Vector3d across = Vector3d(1.0, 2.0, 0.0).normalized();  // perpendicular to it
+        const auto disk = [&](const char* name, double mass, double i, Vector3d at) {
+          sp::Body body{.name = name, .mass = mass, .inertia = sp::Body::principal(i, i, i)};
+          body.position = at;
+          return model.add_body(body);
+        };
+        const auto sun = disk("sun", 0.3, P::inertia_sun, Vector3d::Zero());
+        const auto ring = disk("ring", 1.0, P::inertia_ring, Vector3d::Zero());
+        const auto carrier = disk("carrier", 0.5, P::inertia_carrier, Vector3d::Zero());
+        const auto planet = disk("planet", P::planet_mass, P::inertia_planet, P::radius * across);
+        const sp::JointFrame centre{Vector3d::Zero(), axis};
+        const sp::Revolute sun_hinge("sun hinge", odyn::ground, centre, sun, centre);
+        const sp::Revolute ring_hinge("ring hinge", odyn::ground, centre, ring, centre);
+        const sp::Revolute carrier_hinge("carrier hinge", odyn::ground, centre, carrier, centre);
+        const sp::Revolute planet_pin("planet pin", carrier, {P::radius * across, axis}, planet,
+                                      centre);
+        for (const auto& hinge : {sun_hinge, ring_hinge, carrier_hinge, planet_pin})
+          model.add(hinge);
+        using odyn::JointCoordinateKind::angle;
+        using Coordinate = sp::Coupler::Coordinate;
+        model.add(sp::Coupler("sun mesh", Coordinate{planet_pin, angle, P::teeth_planet},
+                              Coordinate{sun_hinge, angle, P::teeth_sun},
+                              Coordinate{carrier_hinge, angle, -P::teeth_sun}));
+        model.add(sp::Coupler("ring mesh", Coordinate{planet_pin, angle, P::teeth_planet},
+                              Coordinate{ring_hinge, angle, -P::teeth_ring},
+                              Coordinate{carrier_hinge, angle, P::teeth_ring}));
+        model.add(sp::PointTorque("motor", sun, Vector3d(P::torque_sun * axis)));
+        model.add(sp::PointTorque("load", carrier, Vector3d(P::torque_carrier * axis)));
+        odyn::Workspace<sp::DefaultModel> ws(model);
+        odyn::simulate(model, ws, s, [](const auto&) {});
+        const std::array<odyn::BodyId, 4> bodies{sun, ring, carrier, planet};
+        for (int i = 0; i < 4; ++i) {
+          INFO("body " << i);
+          const Eigen::Matrix3d expected = Eigen::AngleAxisd(angles[i], axis).toRotationMatrix();
+          CHECK((ws.frames[bodies[i].index].rotation - expected).norm() <
+                tolerance * std::abs(angles[0]));
+        }
+        // What the meshes pass on to the sun and the ring: their inertia times their
+        // acceleration, less the torque applied on them.
+        CHECK(odyn::element_output(model, ws, "sun mesh", "effort_2") ==
+              Approx(P::inertia_sun * accel[0] - P::torque_sun).epsilon(1e3 * tolerance));
+        CHECK(odyn::element_output(model, ws, "ring mesh", "effort_2") ==
+              Approx(P::inertia_ring * accel[1]).epsilon(1e3 * tolerance));
+        CHECK(odyn::element_output(model, ws, "sun mesh", "coordinate_2") ==
+              Approx(angles[0]).epsilon(tolerance));
+        CHECK(odyn::element_output(model, ws, "sun mesh", "coordinate_1") ==
+              Approx(angles[4]).epsilon(tolerance));
+      }
+      SECTION(std::string("in the plane, ") + integrator + ", " + coordinates) {
+        pl::DefaultModel model;
+        const auto disk = [&](const char* name, double mass, double i, Vector2d at) {
+          return model.add_body(pl::Body{.name = name, .mass = mass, .inertia = i, .position = at});
+        };
+        const auto sun = disk("sun", 0.3, P::inertia_sun, Vector2d::Zero());
+        const auto ring = disk("ring", 1.0, P::inertia_ring, Vector2d::Zero());
+        const auto carrier = disk("carrier", 0.5, P::inertia_carrier, Vector2d::Zero());
+        const auto planet =
+            disk("planet", P::planet_mass, P::inertia_planet, Vector2d(0.0, P::radius));
+        const pl::Revolute sun_hinge("sun hinge", odyn::ground, {}, sun, {});
+        const pl::Revolute ring_hinge("ring hinge", odyn::ground, {}, ring, {});
+        const pl::Revolute carrier_hinge("carrier hinge", odyn::ground, {}, carrier, {});
+        const pl::Revolute planet_pin("planet pin", carrier, {Vector2d(0.0, P::radius)}, planet,
+                                      {});
+        for (const auto& hinge : {sun_hinge, ring_hinge, carrier_hinge, planet_pin})
+          model.add(hinge);
+        using odyn::JointCoordinateKind::angle;
+        using Coordinate = pl::Coupler::Coordinate;
+        model.add(pl::Coupler("sun mesh", Coordinate{planet_pin, angle, P::teeth_planet},
+                              Coordinate{sun_hinge, angle, P::teeth_sun},
+                              Coordinate{carrier_hinge, angle, -P::teeth_sun}));
+        model.add(pl::Coupler("ring mesh", Coordinate{planet_pin, angle, P::teeth_planet},
+                              Coordinate{ring_hinge, angle, -P::teeth_ring},
+                              Coordinate{carrier_hinge, angle, P::teeth_ring}));
+        model.add(pl::PointTorque("motor", sun, P::torque_sun));
+        model.add(pl::PointTorque("load", carrier, P::torque_carrier));
+        odyn::Workspace<pl::DefaultModel> ws(model);
+        odyn::simulate(model, ws, s, [](const auto&) {});
+        const std::array<odyn::BodyId, 4> bodies{sun, ring, carrier, planet};
+        for (int i = 0; i < 4; ++i) {
+          INFO("body " << i);
+          CHECK(ws.frames[bodies[i].index].angle ==
+                Approx(angles[i]).margin(tolerance * std::abs(angles[0])));
+        }
+        CHECK(odyn::element_output(model, ws, "ring mesh", "effort_2") ==
+              Approx(P::inertia_ring * accel[1]).epsilon(1e3 * tolerance));
+      }
+    }
+  }
+}
+
+TEST_CASE("Zero ratios, radii, pitches and scales are refused by name", "[gears]") {
   const sp::Revolute a("a", odyn::ground, {}, odyn::BodyId{1}, {});
   const sp::Translational t("t", odyn::ground, {}, odyn::BodyId{2}, {});
   const sp::Cylindrical c("c", odyn::ground, {}, odyn::BodyId{1}, {});
@@ -326,6 +484,11 @@ TEST_CASE("Zero ratios, radii and pitches are refused by name", "[gears]") {
                     Catch::Contains("drive") && Catch::Contains("radius is nan"));
   CHECK_THROWS_WITH(sp::ScrewJoint("lead", c, 0.0),
                     Catch::Contains("lead") && Catch::Contains("pitch is 0"));
+  using odyn::JointCoordinateKind::angle;
+  using Coordinate = sp::Coupler::Coordinate;
+  CHECK_THROWS_WITH(sp::Coupler("couple", Coordinate{a, angle, 1.0}, Coordinate{c, angle, 2.0},
+                                Coordinate{t, odyn::JointCoordinateKind::slide, 0.0}),
+                    Catch::Contains("couple") && Catch::Contains("scale_3 is 0"));
 }
 
 }  // namespace test_gears

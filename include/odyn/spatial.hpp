@@ -1,6 +1,7 @@
 #pragma once
 // The spatial element catalogue and the model types built from it.
 
+#include "odyn/core/coupler.hpp"
 #include "odyn/core/model.hpp"
 #include "odyn/forces/contact.hpp"
 #include "odyn/forces/gravity.hpp"
@@ -35,11 +36,14 @@ using BoxPlane = BoxPlaneT<Spatial>;
 using CapsulePlane = CapsulePlaneT<Spatial>;
 using Gear = GearT<PairJoint, JointFrame>;
 using RackPinion = RackPinionT<PairJoint, JointFrame>;
+using Coupler = CouplerT<PairJoint, JointFrame>;
 using JointFriction = JointFrictionT<PairJoint>;
 
-/// The joint types a turning_joint (its angle) or a sliding_joint (its slide) parameter names.
+/// The joint types a turning_joint (its angle), a sliding_joint (its slide) or a coupled_joint
+/// (either) parameter names.
 inline constexpr auto turning_joint_types = parameters::turning_joints;
 inline constexpr auto sliding_joint_types = parameters::sliding_joints;
+inline constexpr auto coupled_joint_types = parameters::coupled_joints;
 
 /// A spatial model holding just the element types a scene lists.
 template <class... Elements>
@@ -49,8 +53,8 @@ using Model = odyn::Model<Body, Elements...>;
 using DefaultModel =
     Model<Revolute, Translational, Spherical, Universal, CvJoint, Cylindrical, Fixed, Distance,
           PlanarJoint, InLine, InPlane, Orientation, ParallelAxes, Perpendicular, Gear, RackPinion,
-          ScrewJoint, RevoluteDriver, TranslationalDriver, Gravity, PointForce, PointTorque, Tsda,
-          Rsda, Bushing, SpherePlane, SphereSphere, BoxPlane, CapsulePlane, RevoluteLimit,
-          TranslationalLimit, JointFriction>;
+          Coupler, ScrewJoint, RevoluteDriver, TranslationalDriver, Gravity, PointForce,
+          PointTorque, Tsda, Rsda, Bushing, SpherePlane, SphereSphere, BoxPlane, CapsulePlane,
+          RevoluteLimit, TranslationalLimit, JointFriction>;
 
 }  // namespace odyn::spatial

@@ -255,6 +255,34 @@ class SpatialElements(_Adds):
         """
         return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
 
+    def add_coupler(
+            self, name: str, joint_1: str, *, coordinate_1: Optional[str] = None, scale_1: float,
+            joint_2: str, coordinate_2: Optional[str] = None, scale_2: float,
+            joint_3: Optional[str] = None, coordinate_3: Optional[str] = None,
+            scale_3: Optional[float] = None) -> str:
+        """Coupler: scale_1 (x_1 - x_10) + scale_2 (x_2 - x_20) [+ scale_3 (x_3 - x_30)] = 0, x_i
+        the angle or slide of two or three joints, for any number of turns. 1 equation.
+
+        name: the element's name.
+        joint_1: the first joint (its coordinate x_1).
+        coordinate_1: x_1: "angle" or "slide"; null: the joint's own (a cylindrical joint needs
+        one).
+        scale_1: c_1, nonzero (per rad of an angle, per m of a slide).
+        joint_2: the second joint (its coordinate x_2).
+        coordinate_2: x_2: as coordinate_1.
+        scale_2: c_2, nonzero.
+        joint_3: a third joint (x_3), or null for two.
+        coordinate_3: x_3: as coordinate_1 (with joint_3).
+        scale_3: c_3, nonzero (with joint_3).
+
+        Outputs (Result.output(name)): coordinate_1 (rad or m), coordinate_2 (rad or m),
+        coordinate_3 (rad or m), effort_1 (N m or N), effort_2 (N m or N), effort_3 (N m or N).
+        """
+        return self._add_given(
+            "coupler", name=name, joint_1=joint_1, coordinate_1=coordinate_1, scale_1=scale_1,
+            joint_2=joint_2, coordinate_2=coordinate_2, scale_2=scale_2, joint_3=joint_3,
+            coordinate_3=coordinate_3, scale_3=scale_3)
+
     def add_screw(
             self, name: str, *, joint: Optional[str] = None, body_a: Optional[str] = None,
             on_a: Optional[Frame] = None, body_b: Optional[str] = None,
@@ -819,6 +847,34 @@ class PlanarElements(_Adds):
         Outputs (Result.output(name)): angle (rad), slide (m), torque (N m), force (N).
         """
         return self._add_given("rack_pinion", name=name, pinion=pinion, rack=rack, radius=radius)
+
+    def add_coupler(
+            self, name: str, joint_1: str, *, coordinate_1: Optional[str] = None, scale_1: float,
+            joint_2: str, coordinate_2: Optional[str] = None, scale_2: float,
+            joint_3: Optional[str] = None, coordinate_3: Optional[str] = None,
+            scale_3: Optional[float] = None) -> str:
+        """Coupler: scale_1 (x_1 - x_10) + scale_2 (x_2 - x_20) [+ scale_3 (x_3 - x_30)] = 0, x_i
+        the angle or slide of two or three joints, for any number of turns. 1 equation.
+
+        name: the element's name.
+        joint_1: the first joint (its coordinate x_1).
+        coordinate_1: x_1: "angle" or "slide"; null: the joint's own (a cylindrical joint needs
+        one).
+        scale_1: c_1, nonzero (per rad of an angle, per m of a slide).
+        joint_2: the second joint (its coordinate x_2).
+        coordinate_2: x_2: as coordinate_1.
+        scale_2: c_2, nonzero.
+        joint_3: a third joint (x_3), or null for two.
+        coordinate_3: x_3: as coordinate_1 (with joint_3).
+        scale_3: c_3, nonzero (with joint_3).
+
+        Outputs (Result.output(name)): coordinate_1 (rad or m), coordinate_2 (rad or m),
+        coordinate_3 (rad or m), effort_1 (N m or N), effort_2 (N m or N), effort_3 (N m or N).
+        """
+        return self._add_given(
+            "coupler", name=name, joint_1=joint_1, coordinate_1=coordinate_1, scale_1=scale_1,
+            joint_2=joint_2, coordinate_2=coordinate_2, scale_2=scale_2, joint_3=joint_3,
+            coordinate_3=coordinate_3, scale_3=scale_3)
 
     def add_revolute_driver(
             self, name: str, motion: Mapping[str, Any], *, joint: Optional[str] = None,

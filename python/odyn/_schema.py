@@ -220,6 +220,12 @@ def check_component_matrix(x: Any, where: str, size: int) -> List[List[float]]:
     return [check_vector(row, f"{where}[{i}]", size) for i, row in enumerate(x)]
 
 
+#: The coordinates of a joint a coupler may take.
+COORDINATES = ("angle", "slide")
+#: The coordinate each joint type has, where it has one only.
+OWN_COORDINATE = {"revolute": "angle", "translational": "slide"}
+
+
 def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[Any, str, Any],
                                                                           Any]]:
     """How each parameter kind (odyn/core/description.hpp) checks a value in a space whose
@@ -252,6 +258,9 @@ def _kinds(dim: int, frame: Callable[[Any, str], Any]) -> Dict[str, Callable[[An
         "joint": lambda x, w, b: check_name(x, w),
         "turning_joint": joint_reference,
         "sliding_joint": joint_reference,
+        "coupled_joint": joint_reference,
+        "optional_coupled_joint": lambda x, w, b: None if x is None else joint_reference(x, w, b),
+        "coordinate": lambda x, w, b: None if x is None else check_choice(x, w, COORDINATES),
         "vector": lambda x, w, b: check_vector(x, w, dim),
         "frame": lambda x, w, b: frame({} if x is None else x, w),
         "number": lambda x, w, b: check_number(x, w),
@@ -385,8 +394,10 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
             joint = check_name(params[key], f"{where}.{key}")
             types = JOINT_KINDS[space][param_kind]
             if joint not in elements or elements[joint][0] not in types:
-                fail(f"{where}.{key}", f"no {' or '.join(types)} joint named '{joint}' before "
-                     f"this {kind}")
+                either = " or ".join([", ".join(types[:-1]), types[-1]] if len(types) > 1
+                                     else types)
+                fail(f"{where}.{key}", f"no {either} joint named '{joint}' before this {kind}")
+            _check_coordinate(params, spec, key, joint, elements[joint][0], where)
             params[key] = {k: elements[joint][1][k] for k in ("body_a", "on_a", "body_b", "on_b")}
     check_keys(params, where, list(spec), required)
     out: Dict[str, Any] = {}
@@ -406,6 +417,26 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     if "bodies" in out and len(set(out["bodies"])) != len(out["bodies"]):
         fail(f"{where}.bodies", "the bodies must be different")
     return out
+
+
+def _check_coordinate(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]], key: str,
+                      joint: str, joint_type: str, where: str) -> None:
+    """Fills in or checks the coordinate that goes with a coupled joint named by `key`
+    (coordinate_1 with joint_1): a revolute joint's is its angle, a translational joint's its
+    slide; a cylindrical joint's must be given."""
+    coordinate = "coordinate" + key[len("joint"):]
+    if spec.get(coordinate, ("",))[0] != "coordinate":
+        return
+    given = params.get(coordinate)
+    own = OWN_COORDINATE.get(joint_type)
+    if given is None:
+        if own is None:
+            fail(f"{where}.{coordinate}", f"'{joint}' is a {joint_type} joint, which both turns "
+                 "and slides; give \"angle\" or \"slide\"")
+        params[coordinate] = own
+    elif own is not None and given != own and given in COORDINATES:
+        fail(f"{where}.{coordinate}", f"'{joint}' is a {joint_type} joint, which has no "
+             f"{given}; its coordinate is its {own}")
 
 
 BODY: Dict[str, Tuple[str, Any]] = {

@@ -488,20 +488,21 @@ using Model =
     sp::Model<sp::Revolute, sp::Translational, sp::Spherical, sp::Universal, sp::CvJoint,
               sp::Cylindrical, sp::Fixed, sp::Distance, sp::PlanarJoint, sp::InLine, sp::InPlane,
               sp::Orientation, sp::ParallelAxes, sp::Perpendicular, sp::Gear, sp::RackPinion,
-              sp::ScrewJoint, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
+              sp::Coupler, sp::ScrewJoint, sp::RevoluteDriver, sp::TranslationalDriver, sp::Gravity,
               sp::PointForce, sp::PointTorque, sp::Tsda, sp::Rsda, sp::Bushing, sp::SpherePlane,
               sp::SphereSphere, sp::BoxPlane, sp::CapsulePlane, sp::RevoluteLimit,
               sp::TranslationalLimit, sp::JointFriction, EngineGasForce, UserForceT<Spatial, 1>,
               UserForceT<Spatial, 2>, UserConstraintT<Spatial>, SignalWatch<Spatial>>;
 
 /// The planar model type of the bindings.
-using PlanarModel = pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine,
-                              pl::Gear, pl::RackPinion, pl::RevoluteDriver, pl::TranslationalDriver,
-                              pl::Gravity, pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda,
-                              pl::Bushing, pl::CircleLine, pl::CircleCircle, pl::RectangleLine,
-                              pl::CapsuleLine, pl::RevoluteLimit, pl::TranslationalLimit,
-                              pl::JointFriction, PlanarEngineGasForce, UserForceT<Planar, 1>,
-                              UserForceT<Planar, 2>, UserConstraintT<Planar>, SignalWatch<Planar>>;
+using PlanarModel =
+    pl::Model<pl::Revolute, pl::Translational, pl::Fixed, pl::Distance, pl::InLine, pl::Gear,
+              pl::RackPinion, pl::Coupler, pl::RevoluteDriver, pl::TranslationalDriver, pl::Gravity,
+              pl::PointForce, pl::PointTorque, pl::Tsda, pl::Rsda, pl::Bushing, pl::CircleLine,
+              pl::CircleCircle, pl::RectangleLine, pl::CapsuleLine, pl::RevoluteLimit,
+              pl::TranslationalLimit, pl::JointFriction, PlanarEngineGasForce,
+              UserForceT<Planar, 1>, UserForceT<Planar, 2>, UserConstraintT<Planar>,
+              SignalWatch<Planar>>;
 
 /// True if `Target` compiles every element type of the library's catalogue `Catalogue` (its
 /// DefaultModel): a new element in the library fails this check until the bindings have it.

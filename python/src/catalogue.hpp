@@ -57,6 +57,11 @@ struct IsJointReference<parameters::JointReference<F>> : std::true_type {
 };
 
 template <class T>
+struct IsOptional : std::false_type {};
+template <class T>
+struct IsOptional<std::optional<T>> : std::true_type {};
+
+template <class T>
 inline constexpr bool always_false = false;
 
 }  // namespace detail
@@ -84,9 +89,14 @@ class DictReader {
       return value.cast<std::vector<std::string>>();
     } else if constexpr (std::is_same_v<T, double>) {
       return value.cast<double>();
-    } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+    } else if constexpr (detail::IsOptional<T>::value) {
       if (value.is_none()) return std::nullopt;
-      return value.cast<double>();
+      return get<typename T::value_type>(key);
+    } else if constexpr (std::is_same_v<T, JointCoordinateKind>) {
+      const std::string kind = value.cast<std::string>();
+      if (kind != "angle" && kind != "slide")
+        throw ModelError(what_, std::string(key) + " is '" + kind + "'; expected angle or slide");
+      return kind == "angle" ? JointCoordinateKind::angle : JointCoordinateKind::slide;
     } else if constexpr (std::is_same_v<T, bool>) {
       return value.cast<bool>();
     } else if constexpr (std::is_same_v<T, BodyId>) {

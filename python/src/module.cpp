@@ -317,25 +317,31 @@ py::list kinds() {
   return out;
 }
 
-/// {"turning_joint": [types], "sliding_joint": [types]}: what those kinds may name in a space.
+/// {"turning_joint": [types], "sliding_joint": [types], "coupled_joint": [types],
+/// "optional_coupled_joint": [types]}: what those kinds may name in a space.
 template <class Kinds>
 py::dict joint_kinds() {
   py::dict out;
-  py::list turning, sliding;
+  py::list turning, sliding, coupled;
   for (const char* type : Kinds::turning_joint_types) turning.append(type);
   for (const char* type : Kinds::sliding_joint_types) sliding.append(type);
+  for (const char* type : Kinds::coupled_joint_types) coupled.append(type);
   out["turning_joint"] = turning;
   out["sliding_joint"] = sliding;
+  out["coupled_joint"] = coupled;
+  out["optional_coupled_joint"] = coupled;
   return out;
 }
 
 struct SpatialJointKinds {
   static constexpr auto turning_joint_types = odyn::spatial::turning_joint_types;
   static constexpr auto sliding_joint_types = odyn::spatial::sliding_joint_types;
+  static constexpr auto coupled_joint_types = odyn::spatial::coupled_joint_types;
 };
 struct PlanarJointKinds {
   static constexpr auto turning_joint_types = odyn::planar::turning_joint_types;
   static constexpr auto sliding_joint_types = odyn::planar::sliding_joint_types;
+  static constexpr auto coupled_joint_types = odyn::planar::coupled_joint_types;
 };
 
 }  // namespace

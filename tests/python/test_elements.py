@@ -586,7 +586,7 @@ def test_stops_are_covered_by_their_own_tests():
 
 
 def test_gears_are_covered_by_their_own_tests():
-    covers("gear", "rack_pinion", "screw")  # tests/python/test_gears.py
+    covers("gear", "rack_pinion", "screw", "coupler")  # tests/python/test_gears.py
 
 
 def test_joint_friction_is_covered_by_its_own_tests():

@@ -2,7 +2,8 @@
 gear pair turns as one inertia I_a + ratio^2 I_b for many turns (with the mesh torque on gear a
 from the reactions and the outputs), a three-gear train's work-energy balance, a pushed rack
 and its pinion, a nut sinking down a lead screw (with the torque and force the coupling passes
-on); scene files and bad input."""
+on), a planetary gear set of three-joint couplers against its Lagrangian and Willis's relation,
+a coupler of a slide and an angle; scene files and bad input."""
 
 import json
 import math
@@ -204,3 +205,134 @@ def test_bad_racks_and_screws_are_refused_by_name():
     s.add_cylindrical("shaft", "ground", body_b="nut")
     with pytest.raises(odyn.ModelError, match="thread.*pitch is 0"):
         s.add_screw("thread", joint="shaft", pitch=0.0)
+
+
+# A planetary set: sun, ring and carrier on coaxial hinges, one planet on the carrier. Teeth, the
+# planet's pitch radius, inertias and the torques on the sun and the carrier.
+TEETH_SUN, TEETH_PLANET, TEETH_RING = 24, 18, 60
+PLANET_RADIUS = 0.002 * (TEETH_SUN + TEETH_PLANET) / 2
+INERTIA = {"sun": 0.002, "ring": 0.03, "carrier": 0.01, "planet": 8e-4}
+PLANET_MASS, TORQUE_SUN, TORQUE_CARRIER = 0.4, 0.05, -0.03
+
+
+def planetary(space):
+    """The set, its meshes as couplers of three joint angles (phi the planet's on the carrier):
+    Z_p phi + Z_s (theta_s - theta_c) = 0 and Z_p phi - Z_r (theta_r - theta_c) = 0."""
+    planar = space == "planar"
+    m = odyn.PlanarModel() if planar else odyn.Model()
+    at = [0.0, PLANET_RADIUS] if planar else [0.0, PLANET_RADIUS, 0.0]
+    for name in ("sun", "ring", "carrier", "planet"):
+        i = INERTIA[name]
+        mass = PLANET_MASS if name == "planet" else 0.5
+        m.add_body(name, mass, i if planar else [i, i, i],
+                   position=at if name == "planet" else [0.0] * len(at))
+        if name != "planet":
+            m.add_revolute(f"{name} hinge", "ground", body_b=name)
+    m.add_revolute("planet pin", "carrier", on_a={"point": at}, body_b="planet")
+    m.add_coupler("sun mesh", joint_1="planet pin", scale_1=TEETH_PLANET,
+                  joint_2="sun hinge", scale_2=TEETH_SUN,
+                  joint_3="carrier hinge", scale_3=-TEETH_SUN)
+    m.add_coupler("ring mesh", joint_1="planet pin", scale_1=TEETH_PLANET,
+                  joint_2="ring hinge", scale_2=-TEETH_RING,
+                  joint_3="carrier hinge", scale_3=TEETH_RING)
+    m.add_point_torque("motor", "sun", TORQUE_SUN if planar else [0, 0, TORQUE_SUN])
+    m.add_point_torque("load", "carrier", TORQUE_CARRIER if planar else [0, 0, TORQUE_CARRIER])
+    return m
+
+
+def planetary_reference():
+    """The velocities (sun, ring, carrier, planet in the ground, planet on the carrier) as a
+    5 x 2 matrix times (theta_s', theta_r'), and (theta_s'', theta_r'') from Lagrange's
+    equations in those two coordinates."""
+    c_sun = TEETH_SUN / (TEETH_SUN + TEETH_RING)
+    a = np.zeros((5, 2))
+    a[0], a[1], a[2] = [1, 0], [0, 1], [c_sun, 1 - c_sun]
+    a[4] = -TEETH_SUN / TEETH_PLANET * (a[0] - a[2])
+    a[3] = a[2] + a[4]
+    inertia = np.diag([INERTIA["sun"], INERTIA["ring"],
+                       INERTIA["carrier"] + PLANET_MASS * PLANET_RADIUS ** 2, INERTIA["planet"],
+                       0.0])
+    torque = np.array([TORQUE_SUN, 0.0, TORQUE_CARRIER, 0.0, 0.0])
+    return a, np.linalg.solve(a.T @ inertia @ a, a.T @ torque)
+
+
+@pytest.mark.parametrize("space", ["spatial", "planar"])
+@pytest.mark.parametrize("coordinates", ["absolute", "joint"])
+def test_a_planetary_set_of_couplers_keeps_willis_relation(space, coordinates, tmp_path):
+    """The sun turns 2.4 times in 1.5 s; every joint angle follows the Lagrangian's, Willis's
+    (theta_s - theta_c) / (theta_r - theta_c) = -Z_r / Z_s holds throughout, and what each
+    mesh passes on to the sun and the ring is their inertia times their acceleration, less the
+    torque on them. A scene file's round trip keeps the couplers."""
+    m = planetary(space)
+    a, accel = planetary_reference()
+    settings = {"t_end": 1.5, "output_interval": 0.1, "integrator": "dop853", "rtol": 1e-11,
+                "atol": 1e-13, "coordinates": coordinates}
+    path = tmp_path / "planetary.json"
+    odyn.save(odyn.Scene(m, settings), str(path))
+    for r in (odyn.simulate(m, **settings), odyn.load(str(path)).simulate()):
+        angles = np.outer(0.5 * r.t ** 2, a @ accel)
+        sun, ring = r.output("sun mesh", "coordinate_2"), r.output("ring mesh", "coordinate_2")
+        carrier = r.output("sun mesh", "coordinate_3")
+        np.testing.assert_allclose(sun, angles[:, 0], rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose(ring, angles[:, 1], rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose(carrier, angles[:, 2], rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose(r.output("ring mesh", "coordinate_1"), angles[:, 4],
+                                   rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose((sun - carrier)[1:] / (ring - carrier)[1:],
+                                   -TEETH_RING / TEETH_SUN, rtol=1e-8)
+        assert sun[-1] / (2 * math.pi) > 2.3
+        np.testing.assert_allclose(r.output("sun mesh", "effort_2")[1:],
+                                   INERTIA["sun"] * accel[0] - TORQUE_SUN, rtol=1e-7)
+        np.testing.assert_allclose(r.output("ring mesh", "effort_2")[1:],
+                                   INERTIA["ring"] * accel[1], rtol=1e-7)
+
+
+@pytest.mark.parametrize("space", ["spatial", "planar"])
+def test_a_coupler_of_a_slide_and_an_angle_is_a_rack(space):
+    """A coupler of two joints, a slider's slide and a hinge's angle: s = r theta, and
+    (m + I / r^2) s'' = F under a push on the slider."""
+    mass, inertia, radius, force = 2.0, 0.01, 0.05, 3.0
+    planar = space == "planar"
+    m = odyn.PlanarModel() if planar else odyn.Model()
+    m.add_body("pinion", 0.5, inertia if planar else [0.2, 0.2, inertia])
+    m.add_body("slider", mass, 1.0 if planar else [1, 1, 1])
+    x = [1.0, 0.0] if planar else [1.0, 0.0, 0.0]
+    m.add_revolute("hinge", "ground", body_b="pinion")
+    m.add_translational("guide", "ground", on_a={"axis": x}, body_b="slider", on_b={"axis": x})
+    m.add_coupler("drive", joint_1="guide", scale_1=1.0, joint_2="hinge", scale_2=-radius)
+    assert m.element("drive")["coordinate_1"] == "slide"
+    assert m.element("drive")["coordinate_2"] == "angle"
+    m.add_point_force("push", "slider", [force * c for c in x])
+    r = odyn.simulate(m, t_end=1.0, output_interval=0.1, integrator="dop853", rtol=1e-11,
+                      atol=1e-13)
+    accel = force / (mass + inertia / radius ** 2)
+    np.testing.assert_allclose(r.output("drive", "coordinate_1"), 0.5 * accel * r.t ** 2,
+                               rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r.output("drive", "coordinate_2"),
+                               0.5 * accel * r.t ** 2 / radius, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r.output("drive", "effort_2")[1:], inertia * accel / radius,
+                               rtol=1e-8)
+    np.testing.assert_allclose(r.output("drive", "coordinate_3"), 0.0)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"scale_1": 0.0}, "scale_1 is 0"),
+    ({"coordinate_1": "slide"}, "'planet pin' is a revolute joint, which has no slide"),
+    ({"coordinate_1": "twist"}, "twist"),
+    ({"joint_2": "shaft"}, "'shaft' is a cylindrical joint, which both turns and slides"),
+    ({"joint_3": None}, "scale_3 is given without joint_3"),
+    ({"scale_3": None}, "joint_3 is given without scale_3"),
+    ({"scale_3": float("nan")}, "scale_3: expected a finite number"),
+    ({"joint_3": "motor"}, "no revolute, translational or cylindrical joint named 'motor'"),
+    ({"ratio": 2.0}, "unknown"),
+])
+def test_bad_couplers_are_refused_by_name(kwargs, words):
+    m = planetary("spatial")
+    m.add_body("nut", 1.0, [0.1, 0.1, 0.1])
+    m.add_cylindrical("shaft", "ground", body_b="nut")
+    given = {"joint_1": "planet pin", "scale_1": 18.0, "joint_2": "sun hinge", "scale_2": 24.0,
+             "joint_3": "carrier hinge", "scale_3": -24.0, **kwargs}
+    given = {k: v for k, v in given.items() if v is not None}
+    with pytest.raises((odyn.ModelError, odyn.SceneError)) as error:
+        m.add("coupler", name="bad", **given)
+    assert "bad" in str(error.value) and words in str(error.value)

@@ -263,7 +263,7 @@ def test_stops_are_covered_by_their_own_tests():
 
 
 def test_gears_are_covered_by_their_own_tests():
-    covers("gear", "rack_pinion")  # tests/python/test_gears.py
+    covers("gear", "rack_pinion", "coupler")  # tests/python/test_gears.py
 
 
 def test_joint_friction_is_covered_by_its_own_tests():

@@ -52,7 +52,7 @@ struct ParameterKind {
 };
 
 /// Every kind a description may use. A vector's, a wrench's or a matrix's default 0 is zero.
-inline constexpr std::array<ParameterKind, 23> parameter_kinds{{
+inline constexpr std::array<ParameterKind, 26> parameter_kinds{{
     {"name", "a name, unique among the model's bodies and elements"},
     {"body", "a body's name (\"ground\" for the ground)"},
     {"bodies", "a list of one or two body names"},
@@ -63,6 +63,13 @@ inline constexpr std::array<ParameterKind, 23> parameter_kinds{{
     {"sliding_joint",
      "the name of a translational or cylindrical joint added before (in the plane: a "
      "translational joint), whose slide the element takes"},
+    {"coupled_joint",
+     "the name of a revolute, translational or cylindrical joint added before (in the plane: a "
+     "revolute or translational joint), whose angle or slide the element takes"},
+    {"optional_coupled_joint", "a coupled_joint, or null for none"},
+    {"coordinate",
+     "\"angle\" or \"slide\": which coordinate of a joint; null: the joint's own (a "
+     "revolute's angle, a translational joint's slide)"},
     {"vector", "3 numbers in space, 2 in the plane"},
     {"frame",
      "a joint frame on a body, in body coordinates: {point, axis, reference} in space (left out: "

@@ -7,7 +7,9 @@
 // number of turns and any ratio.
 //
 // The element acts on the joints' bodies, each once: a body two joints share (a gearbox's
-// carrier) takes one slot, and the slot it would have taken again holds the ground.
+// carrier) takes one slot, and the slot it would have taken again holds the ground. A coupling
+// may use fewer than N of its terms (a coupler of two joints where three fit): the terms past
+// `count` take no part, and their slots hold the ground.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -25,7 +27,7 @@ namespace odyn {
 
 enum class JointCoordinateKind { angle, slide };
 
-/// Pair: a space's two-body joint base (with angle_row and slide_row); N: the joints.
+/// Pair: a space's two-body joint base (with angle_row and slide_row); N: the joints it holds.
 template <class Pair, int N>
 class JointCouplingT {
  public:
@@ -46,9 +48,10 @@ class JointCouplingT {
     std::array<double, N> angle{};  // the angles, whole turns counted, at the last step
   };
 
-  JointCouplingT(std::string name, std::array<Term, N> terms)
-      : name_(std::move(name)), terms_(std::move(terms)) {
-    for (int i = 0; i < N; ++i) {
+  /// count: how many of the terms the relation uses, the first ones (2 to N).
+  JointCouplingT(std::string name, std::array<Term, N> terms, int count = N)
+      : name_(std::move(name)), terms_(std::move(terms)), count_(count) {
+    for (int i = 0; i < count_; ++i) {
       for (int side = 0; side < 2; ++side) {
         const BodyId body = terms_[i].joint.bodies()[side];
         int slot = 2 * i + side;
@@ -66,10 +69,12 @@ class JointCouplingT {
   const std::string& name() const { return name_; }
   const std::array<BodyId, num_bodies>& bodies() const { return bodies_; }
   const Term& term(int i) const { return terms_[i]; }
+  /// How many joints the relation couples.
+  int count() const { return count_; }
 
   /// Completes each joint's frames, and takes each coordinate's value at the initial pose.
   void bind(const Input& in) {
-    for (int i = 0; i < N; ++i) {
+    for (int i = 0; i < count_; ++i) {
       const PairInput pair = pair_input(in, i);
       terms_[i].joint.bind(pair);
       initial_[i] = row(pair, i, 0.0).value;
@@ -78,18 +83,18 @@ class JointCouplingT {
 
   State initial_state(const Input& in) const {
     State state;
-    for (int i = 0; i < N; ++i) state.angle[i] = row(pair_input(in, i), i, initial_[i]).value;
+    for (int i = 0; i < count_; ++i) state.angle[i] = row(pair_input(in, i), i, initial_[i]).value;
     return state;
   }
   void advance(const Input& in, State& state) const {
-    for (int i = 0; i < N; ++i) state.angle[i] = coordinate(in, state, i);
+    for (int i = 0; i < count_; ++i) state.angle[i] = coordinate(in, state, i);
   }
 
   void evaluate(const Input& in, const State& state, BlocksOf<JointCouplingT>& out) const {
     out.phi[0] = 0.0;
     out.phi_t[0] = 0.0;
     for (auto& block : out.jacobian) block.setZero();
-    for (int i = 0; i < N; ++i) {
+    for (int i = 0; i < count_; ++i) {
       const JointRow<Space> x = row(pair_input(in, i), i, state.angle[i]);
       const double c = terms_[i].coefficient;
       out.phi[0] += c * (x.value - initial_[i]);
@@ -101,7 +106,7 @@ class JointCouplingT {
 
   Eigen::Matrix<double, 1, 1> gamma(const Input& in, const State& state) const {
     double value = 0.0;
-    for (int i = 0; i < N; ++i)
+    for (int i = 0; i < count_; ++i)
       value += terms_[i].coefficient * row(pair_input(in, i), i, state.angle[i]).gamma;
     return Eigen::Matrix<double, 1, 1>(value);
   }
@@ -111,7 +116,7 @@ class JointCouplingT {
   double step_limit(const Input& in, const State& state) const {
     double limit = std::numeric_limits<double>::infinity();
     if constexpr (Pair::angle_counts_turns_by_state)
-      for (int i = 0; i < N; ++i) {
+      for (int i = 0; i < count_; ++i) {
         if (terms_[i].kind != JointCoordinateKind::angle) continue;
         const PairInput pair = pair_input(in, i);
         Eigen::Matrix<double, 2 * Space::nv, 1> v;
@@ -151,6 +156,7 @@ class JointCouplingT {
   std::string name_;
   std::array<Term, N> terms_;
   std::array<BodyId, num_bodies> bodies_{};
+  int count_;
   std::array<std::array<int, 2>, N> slot_{};
   std::array<double, N> initial_{};
 };

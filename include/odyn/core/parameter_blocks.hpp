@@ -67,6 +67,10 @@ inline constexpr std::array<const char*, 2> turning_joints{"revolute", "cylindri
 inline constexpr std::array<const char*, 1> translational_joints{"translational"};
 inline constexpr std::array<const char*, 2> sliding_joints{"translational", "cylindrical"};
 inline constexpr std::array<const char*, 1> cylindrical_joints{"cylindrical"};
+/// The joint types whose angle or slide a coupler takes, in space and in the plane.
+inline constexpr std::array<const char*, 3> coupled_joints{"revolute", "translational",
+                                                           "cylindrical"};
+inline constexpr std::array<const char*, 2> planar_coupled_joints{"revolute", "translational"};
 
 /// A rotational spring-damper-actuator's law.
 inline constexpr std::array<Parameter, 4> rotational_spring{{
