@@ -108,9 +108,9 @@ TEST_CASE("Bodies: mass and inertia must be physical", "[errors]") {
     body.inertia = sp::Body::principal(1.0, -1.0, 1.0);
     check_rejected(body, {"inertia", "positive definite", "-1"});
   }
-  SECTION("singular inertia") {
-    body.inertia = sp::Body::principal(1.0, 1.0, 0.0);
-    check_rejected(body, {"inertia", "positive definite"});
+  SECTION("singular inertia that no point mass or slender rod has") {
+    body.inertia = sp::Body::principal(1.0, 1.0, -1e-3);
+    check_rejected(body, {"inertia", "positive definite", "slender rod"});
   }
   SECTION("inertia violating the triangle inequality") {
     body.inertia = sp::Body::principal(1.0, 1.0, 3.0);

@@ -354,6 +354,19 @@ struct Planetary {
     a.row(3) = a.row(2) + a.row(4);
     return a;
   }
+  /// The hinges, and the meshes as couplers of their angles.
+  template <class Coupler, class Model, class Revolute>
+  static void add_joints(Model& model, const Revolute& sun, const Revolute& ring,
+                         const Revolute& carrier, const Revolute& planet) {
+    for (const auto& hinge : {sun, ring, carrier, planet}) model.add(hinge);
+    using Coordinate = typename Coupler::Coordinate;
+    constexpr auto angle = odyn::JointCoordinateKind::angle;
+    model.add(Coupler("sun mesh", Coordinate{planet, angle, teeth_planet},
+                      Coordinate{sun, angle, teeth_sun}, Coordinate{carrier, angle, -teeth_sun}));
+    model.add(Coupler("ring mesh", Coordinate{planet, angle, teeth_planet},
+                      Coordinate{ring, angle, -teeth_ring},
+                      Coordinate{carrier, angle, teeth_ring}));
+  }
   /// theta_s'' and theta_r'' from Lagrange's equations in those two coordinates.
   static Eigen::Vector2d accelerations() {
     const Eigen::Matrix<double, 5, 2> a = velocities();
@@ -400,16 +413,7 @@ TEST_CASE("A planetary gear set of couplers keeps Willis's relation", "[gears]")
         const sp::Revolute carrier_hinge("carrier hinge", odyn::ground, centre, carrier, centre);
         const sp::Revolute planet_pin("planet pin", carrier, {P::radius * across, axis}, planet,
                                       centre);
-        for (const auto& hinge : {sun_hinge, ring_hinge, carrier_hinge, planet_pin})
-          model.add(hinge);
-        using odyn::JointCoordinateKind::angle;
-        using Coordinate = sp::Coupler::Coordinate;
-        model.add(sp::Coupler("sun mesh", Coordinate{planet_pin, angle, P::teeth_planet},
-                              Coordinate{sun_hinge, angle, P::teeth_sun},
-                              Coordinate{carrier_hinge, angle, -P::teeth_sun}));
-        model.add(sp::Coupler("ring mesh", Coordinate{planet_pin, angle, P::teeth_planet},
-                              Coordinate{ring_hinge, angle, -P::teeth_ring},
-                              Coordinate{carrier_hinge, angle, P::teeth_ring}));
+        P::add_joints<sp::Coupler>(model, sun_hinge, ring_hinge, carrier_hinge, planet_pin);
         model.add(sp::PointTorque("motor", sun, Vector3d(P::torque_sun * axis)));
         model.add(sp::PointTorque("load", carrier, Vector3d(P::torque_carrier * axis)));
         odyn::Workspace<sp::DefaultModel> ws(model);
@@ -447,16 +451,7 @@ TEST_CASE("A planetary gear set of couplers keeps Willis's relation", "[gears]")
         const pl::Revolute carrier_hinge("carrier hinge", odyn::ground, {}, carrier, {});
         const pl::Revolute planet_pin("planet pin", carrier, {Vector2d(0.0, P::radius)}, planet,
                                       {});
-        for (const auto& hinge : {sun_hinge, ring_hinge, carrier_hinge, planet_pin})
-          model.add(hinge);
-        using odyn::JointCoordinateKind::angle;
-        using Coordinate = pl::Coupler::Coordinate;
-        model.add(pl::Coupler("sun mesh", Coordinate{planet_pin, angle, P::teeth_planet},
-                              Coordinate{sun_hinge, angle, P::teeth_sun},
-                              Coordinate{carrier_hinge, angle, -P::teeth_sun}));
-        model.add(pl::Coupler("ring mesh", Coordinate{planet_pin, angle, P::teeth_planet},
-                              Coordinate{ring_hinge, angle, -P::teeth_ring},
-                              Coordinate{carrier_hinge, angle, P::teeth_ring}));
+        P::add_joints<pl::Coupler>(model, sun_hinge, ring_hinge, carrier_hinge, planet_pin);
         model.add(pl::PointTorque("motor", sun, P::torque_sun));
         model.add(pl::PointTorque("load", carrier, P::torque_carrier));
         odyn::Workspace<pl::DefaultModel> ws(model);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "odyn/analysis/assembly.hpp"
+#include "odyn/analysis/massless_motion.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/analysis/watches.hpp"
 #include "odyn/analysis/zero_crossing.hpp"
@@ -534,13 +535,15 @@ inline OutputGrid output_grid(const DynamicsSettings& s, double t0) {
 }
 
 /// Hands the workspace to the observer at an output, with the blocks of every element up to
-/// date, and keeps the largest constraint residuals.
+/// date, keeps the largest constraint residuals, and checks that no point mass or slender rod
+/// turns where it has no inertia (after the observer, so that partial results show it).
 template <class Model, class Observer>
 struct OutputRecorder {
   const Model& model;
   Workspace<Model>& ws;
   Observer& observe;
   RunSummary& summary;
+  MasslessMotionCheck<Model> check_massless{};
 
   template <class Integrator>
   void operator()(Integrator& integrator) {
@@ -550,6 +553,7 @@ struct OutputRecorder {
     summary.max_velocity_residual = std::max(summary.max_velocity_residual, phid_norm);
     ++summary.outputs;
     observe(std::as_const(ws));
+    check_massless(model, ws);
   }
 };
 

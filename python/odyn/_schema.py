@@ -468,7 +468,7 @@ def check_inertia(x: Any, where: str) -> List[List[float]]:
 PLANAR_BODY: Dict[str, Tuple[str, Any]] = {
     "name": ("name", REQUIRED),
     "mass": ("positive", REQUIRED),
-    "inertia": ("positive", REQUIRED),
+    "inertia": ("nonnegative", REQUIRED),
     "position": ("vector", [0.0, 0.0]),
     "angle": ("number", 0.0),
     "linear_velocity": ("vector", [0.0, 0.0]),

@@ -363,7 +363,8 @@ class Model(BaseModel, SpatialElements):
                  velocity_given: Optional[Sequence[bool]] = None) -> str:
         """Adds a rigid body; returns its name.
 
-        inertia: three principal moments or a 3 x 3 tensor about the centre of mass, body axes.
+        inertia: three principal moments or a 3 x 3 tensor about the centre of mass, body axes;
+        zero for a point mass, [I, I, 0] for a slender rod along body z (docs/bodies.md).
         position: centre of mass (global); orientation: unit quaternion (w, x, y, z), body to
         global; linear_velocity (global) and angular_velocity (body axes) are the initial
         velocity. velocity_given: which of the 6 components assembly should keep (default: the
@@ -393,7 +394,8 @@ class PlanarModel(BaseModel, PlanarElements):
                  velocity_given: Optional[Sequence[bool]] = None) -> str:
         """Adds a planar rigid body; returns its name.
 
-        inertia: moment of inertia about the centre of mass (kg m^2). position: centre of mass;
+        inertia: moment of inertia about the centre of mass (kg m^2); zero for a point mass
+        (docs/bodies.md). position: centre of mass;
         angle: rad, counter-clockwise (it may exceed a turn). linear_velocity and
         angular_velocity: the initial velocity. velocity_given: which of (x', y', phi')
         assembly should keep (default: the non-zero ones).

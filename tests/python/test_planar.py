@@ -312,8 +312,8 @@ def test_spatial_and_planar_elements_do_not_mix():
         m.add_gravity(name="g", acceleration=[0, 0, -9.81])
     with pytest.raises(odyn.SceneError, match=r"on_a\.axis: zero-length vector.*leave 'axis' out"):
         m.add_revolute(name="p", body_a="ground", on_a=odyn.frame([0, 0], [0, 0]), body_b="b")
-    with pytest.raises(odyn.SceneError, match=r"body 'c'\.inertia: expected a positive number"):
-        odyn.PlanarModel().add_body(name="c", mass=1.0, inertia=0.0)
+    with pytest.raises(odyn.SceneError, match=r"body 'c'\.inertia: expected a number >= 0"):
+        odyn.PlanarModel().add_body(name="c", mass=1.0, inertia=-1.0)
 
 
 # --- scenes -------------------------------------------------------------------------------------

@@ -14,6 +14,7 @@
 #include <tuple>
 #include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -55,17 +56,26 @@ class Model {
     std::size_t index;
   };
 
+  /// Where a body lacks inertia (a point mass, a slender rod): Body's MasslessDirections.
+  using Massless = decltype(std::declval<const Body&>().massless());
+
   Model() {
     Body ground_body;
     ground_body.name = "ground";
     bodies_.push_back(ground_body);
+    massless_.emplace_back();
     body_names_.emplace("ground", 0);
   }
 
-  /// Adds a moving body; throws ModelError if it is not physical or its name is taken.
+  /// Adds a moving body; throws ModelError if it is not physical or its name is taken. A point
+  /// mass or a slender rod is kept with a stand-in moment where it has none (see massless).
   BodyId add_body(Body body) {
     body.validate();
     claim_name(body.name);
+    const Massless massless = body.massless();
+    body.inertia = massless.filled(body.inertia);
+    has_massless_bodies_ = has_massless_bodies_ || massless.count > 0;
+    massless_.push_back(massless);
     body_names_.emplace(body.name, static_cast<int>(bodies_.size()));
     bodies_.push_back(std::move(body));
     return BodyId{static_cast<int>(bodies_.size()) - 1};
@@ -106,7 +116,12 @@ class Model {
 
   // --- bodies --------------------------------------------------------------------------
   int num_bodies() const { return static_cast<int>(bodies_.size()) - 1; }  // moving ones
+  /// The body as the equations of motion take it: a point mass's or a slender rod's inertia has
+  /// the stand-in moment where it has none (massless says where).
   const Body& body(BodyId id) const { return bodies_.at(id.index); }
+  const Massless& massless(BodyId id) const { return massless_.at(id.index); }
+  /// True if some body is a point mass or a slender rod.
+  bool has_massless_bodies() const { return has_massless_bodies_; }
   BodyId body(std::string_view name) const {
     const auto it = body_names_.find(std::string(name));
     if (it == body_names_.end())
@@ -240,6 +255,8 @@ class Model {
   }
 
   std::vector<Body> bodies_;
+  std::vector<Massless> massless_;
+  bool has_massless_bodies_ = false;
   std::tuple<std::vector<Elements>...> pools_;
   std::array<std::vector<int>, num_types> row_offsets_;
   std::unordered_map<std::string, int> body_names_;

@@ -1,0 +1,115 @@
+"""Point masses and slender rods, against closed forms: a point mass on a massless rod runs
+round a cone at Omega^2 = g / (L cos alpha) and never turns; a slender rod hung from a
+spherical joint runs round a cone at Omega^2 = 3 g / (2 L cos alpha) without spinning about its
+axis; a point mass swinging in the plane from 2.5 rad returns after the elliptic-integral
+period, also from a scene file; bodies that something turns where they have no inertia are
+refused by name."""
+
+import math
+
+import numpy as np
+import pytest
+
+import odyn
+
+G = 9.81
+
+
+def elliptic_k(m):
+    """The complete elliptic integral of the first kind K(m), m = k^2, by the AGM."""
+    a, b = 1.0, math.sqrt(1.0 - m)
+    while abs(a - b) > 1e-16 * a:
+        a, b = 0.5 * (a + b), math.sqrt(a * b)
+    return math.pi / (2.0 * a)
+
+
+@pytest.mark.parametrize("coordinates", ["absolute", "joint"])
+def test_a_point_mass_on_a_massless_rod_runs_round_a_cone(coordinates):
+    length, alpha = 0.8, 0.6
+    rate = math.sqrt(G / (length * math.cos(alpha)))
+    radius, depth = length * math.sin(alpha), -length * math.cos(alpha)
+    m = odyn.Model()
+    m.add_body("bob", 0.3, [0, 0, 0], position=[radius, 0, depth],
+               linear_velocity=[0, rate * radius, 0])
+    m.add_distance("rod", "ground", body_b="bob", length=length)
+    m.add_gravity("gravity", [0, 0, -G])
+    r = odyn.simulate(m, t_end=3 * 2 * math.pi / rate, output_interval=0.05,
+                      integrator="dop853", coordinates=coordinates, rtol=1e-11, atol=1e-13)
+    bob = r.body("bob")
+    expected = np.column_stack([radius * np.cos(rate * r.t), radius * np.sin(rate * r.t),
+                                np.full_like(r.t, depth)])
+    np.testing.assert_allclose(bob.position, expected, atol=1e-8)
+    assert np.all(bob.angular_velocity == 0.0)
+
+
+def test_a_slender_rod_hung_from_a_spherical_joint_runs_round_a_cone():
+    """The rod lies along its body z; its angular velocity is Omega about the vertical less the
+    part along the rod, which a slender rod has no inertia for."""
+    length, alpha, mass = 0.6, 0.5, 1.5
+    rate = math.sqrt(3 * G / (2 * length * math.cos(alpha)))
+    i = mass * length ** 2 / 12
+    # Body z points up the rod: z turned about y by -alpha, the rod leaning out towards +x.
+    up = np.array([-math.sin(alpha), 0.0, math.cos(alpha)])
+    orientation = [math.cos(alpha / 2), 0.0, -math.sin(alpha / 2), 0.0]
+    rotation = np.array([[math.cos(alpha), 0, -math.sin(alpha)], [0, 1, 0],
+                         [math.sin(alpha), 0, math.cos(alpha)]])
+    np.testing.assert_allclose(rotation @ [0, 0, 1], up, atol=1e-15)
+    omega = rate * (np.array([0.0, 0.0, 1.0]) - math.cos(alpha) * up)
+    centre = -0.5 * length * up
+    m = odyn.Model()
+    m.add_body("rod", mass, [i, i, 0.0], position=centre, orientation=orientation,
+               linear_velocity=rate * np.cross([0, 0, 1], centre),
+               angular_velocity=rotation.T @ omega)
+    m.add_spherical("socket", "ground", body_b="rod", point_b=[0, 0, 0.5 * length])
+    m.add_gravity("gravity", [0, 0, -G])
+    r = odyn.simulate(m, t_end=2 * 2 * math.pi / rate, output_interval=0.05,
+                      integrator="dop853", rtol=1e-11, atol=1e-13)
+    rod = r.body("rod")
+    sweep = rate * r.t
+    expected = 0.5 * length * np.column_stack([math.sin(alpha) * np.cos(sweep),
+                                               math.sin(alpha) * np.sin(sweep),
+                                               np.full_like(r.t, -math.cos(alpha))])
+    np.testing.assert_allclose(rod.position, expected, atol=1e-8)
+    np.testing.assert_allclose(rod.angular_velocity[:, 2], 0.0, atol=1e-9)
+
+
+def test_a_point_mass_in_the_plane_swings_with_the_elliptic_period(tmp_path):
+    """From 2.5 rad at rest, a pendulum of length L returns after 4 sqrt(L / g) K(sin^2(1.25));
+    the scene file keeps the zero moment of inertia."""
+    length, theta0 = 1.2, 2.5
+    period = 4 * math.sqrt(length / G) * elliptic_k(math.sin(theta0 / 2) ** 2)
+    m = odyn.PlanarModel()
+    start = [length * math.sin(theta0), -length * math.cos(theta0)]
+    m.add_body("bob", 0.2, 0.0, position=start)
+    m.add_distance("rod", "ground", body_b="bob", length=length)
+    m.add_gravity("gravity", [0, -G])
+    path = tmp_path / "pendulum.json"
+    settings = {"t_end": period, "output_interval": period / 4, "integrator": "dop853",
+                "rtol": 1e-11, "atol": 1e-13}
+    odyn.save(odyn.Scene(m, settings), str(path))
+    for r in (odyn.simulate(m, **settings), odyn.load(str(path)).simulate()):
+        bob = r.body("bob")
+        np.testing.assert_allclose(bob.position[-1], start, atol=1e-8)
+        np.testing.assert_allclose(bob.position[2], [-start[0], start[1]], atol=1e-8)
+        assert np.all(bob.angle == 0.0)
+
+
+def test_bodies_that_something_turns_where_they_have_no_inertia_are_refused():
+    m = odyn.Model()
+    m.add_body("arm", 1.0, [0.1, 0.1, 0.01], position=[0.5, 0, 0])
+    m.add_body("bob", 0.5, [0, 0, 0], position=[1, 0, 0])
+    m.add_revolute("hinge", "ground", on_a={"axis": [0, 1, 0]}, body_b="arm",
+                   on_b={"point": [-0.5, 0, 0], "axis": [0, 1, 0]})
+    m.add_fixed("weld", "arm", on_a={"point": [0.5, 0, 0]}, body_b="bob")
+    m.add_gravity("gravity", [0, 0, -G])
+    with pytest.raises(odyn.ModelError, match="bob: a point mass has no inertia to turn with.*"
+                       "point joints"):
+        odyn.simulate(m, t_end=0.5, output_interval=0.01, integrator="dop853")
+    with pytest.raises(odyn.ModelError, match="rod: a slender rod has no inertia to spin about "
+                       "its axis"):
+        m.add_body("rod", 1.0, [0.1, 0.1, 0.0], angular_velocity=[0, 0.3, 2.0])
+    with pytest.raises(odyn.ModelError, match="dot: a point mass has no inertia"):
+        odyn.PlanarModel().add_body("dot", 1.0, 0.0, angular_velocity=1.0)
+    with pytest.raises(odyn.ModelError, match="plate: principal moments .* violate the "
+                       "triangle inequality"):
+        m.add_body("plate", 1.0, [1.0, 2.0, 0.0])
