@@ -479,11 +479,24 @@ PLANAR_BODY: Dict[str, Tuple[str, Any]] = {
 
 def check_body(params: Mapping[str, Any], where: str, names: Sequence[str],
                space: str = "spatial") -> Dict[str, Any]:
+    """The body as given, checked and normalized. A body built from `parts` (composite.py)
+    takes its mass and inertia from them and gives neither."""
     spec = PLANAR_BODY if space == "planar" else BODY
     flags = 3 if space == "planar" else 6
-    check_keys(params, where, list(spec), [k for k, (_, d) in spec.items() if d is REQUIRED])
+    own = ("mass", "inertia")  # what parts replace
+    composite = isinstance(params, Mapping) and params.get("parts") is not None
+    if composite:
+        for key in own:
+            if params.get(key) is not None:
+                fail(f"{where}.{key}", "give either mass and inertia or parts, not both: the "
+                     "parts' masses and inertias make the body's")
+        params = {k: v for k, v in params.items() if k not in own}
+    check_keys(params, where, list(spec) + ["parts"],
+               [k for k, (_, d) in spec.items() if d is REQUIRED and not (composite and k in own)])
     out: Dict[str, Any] = {}
     for key, (kind, default) in spec.items():
+        if composite and key in own:
+            continue
         value = params.get(key, default)
         w = f"{where}.{key}"
         if kind == "inertia":
@@ -500,4 +513,7 @@ def check_body(params: Mapping[str, Any], where: str, names: Sequence[str],
             out[key] = SPACE_KINDS[space][kind](value, w, [])
     if out["name"] in names or out["name"] == "ground":
         fail(f"{where}.name", f"the name '{out['name']}' is already used; names must be unique")
+    if composite:
+        from .composite import check_parts  # composite.py builds on this module
+        out["parts"] = check_parts(params["parts"], f"{where}.parts", space)
     return out

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-from . import _core, _schema
+from . import _core, _schema, composite
 from ._elements import PlanarElements, SpatialElements
 from ._schema import SceneError
 
@@ -98,6 +98,8 @@ class BaseModel:
         self._checked: Dict[str, Tuple[str, Dict[str, Any]]] = {}
         # name -> {"name", "body", "at"}: the named points (markers), in the order added.
         self._points: Dict[str, Dict[str, Any]] = {}
+        # body name -> its parts combined (composite.combine), for the bodies built from parts.
+        self._composites: Dict[str, Dict[str, Any]] = {}
         # name -> the event as added and checked (see add_event), in the order added.
         self._events: Dict[str, Dict[str, Any]] = {}
 
@@ -105,13 +107,29 @@ class BaseModel:
         body = _schema.check_body(params, where,
                                   _schema.Names(self._body_index, self._elements, self._points),
                                   self.space)
+        combined = composite.combine(body["parts"], self.space) if "parts" in body else None
         try:
-            self._core.add_body(body)
+            self._core.add_body(body if combined is None else
+                                composite.body_at_centre(body, combined, self.space))
         except _core.ModelError as e:
             raise SceneError(f"{where}: {e}") from None
         self._body_index[body["name"]] = len(self._body_index)
         self._bodies.append(body)
+        if combined is not None:
+            self._composites[body["name"]] = combined
         return body["name"]
+
+    def at(self, body: str, point: Vector, part: Optional[str] = None) -> List[float]:
+        """The body coordinates of a point given in the frame the body's parts are placed in,
+        or, with `part`, in that part's own frame (its centre and axes). A body built from
+        parts has its coordinates' origin at the parts' combined centre of mass: give joints,
+        forces and named points there, for example ``on_b={"point": m.at("arm", [0, 0, 0.5])}``.
+        A body without parts has its coordinates in that frame already."""
+        if body not in self._body_index or body == "ground":
+            raise SceneError(f"{body}: no moving body of that name in the model")
+        given = self._bodies[self._body_index[body] - 1]
+        return composite.point_in_body(point, body, given.get("parts"),
+                                       self._composites.get(body), part, self.space)
 
     # --- elements ---------------------------------------------------------------------------
     @property
@@ -326,9 +344,11 @@ class BaseModel:
         return dict(self._elements[name][1])
 
     def body(self, name: str) -> Dict[str, Any]:
+        """The body as added (as a scene file stores it). A body built from parts also has
+        the combined "mass", "inertia" and "center_of_mass" (in the parts frame)."""
         index = self._body_index.get(name, 0)
         if index > 0:
-            return dict(self._bodies[index - 1])
+            return {**self._bodies[index - 1], **self._composites.get(name, {})}
         raise SceneError(f"{name}: no body of that name in the model")
 
     @property
@@ -357,10 +377,11 @@ class Model(BaseModel, SpatialElements):
     space = "spatial"
 
     # --- bodies -----------------------------------------------------------------------------
-    def add_body(self, name: str, mass: float, inertia: Any, position: Vector = (0, 0, 0),
-                 orientation: Vector = (1, 0, 0, 0), linear_velocity: Vector = (0, 0, 0),
-                 angular_velocity: Vector = (0, 0, 0),
-                 velocity_given: Optional[Sequence[bool]] = None) -> str:
+    def add_body(self, name: str, mass: Optional[float] = None, inertia: Any = None,
+                 position: Vector = (0, 0, 0), orientation: Vector = (1, 0, 0, 0),
+                 linear_velocity: Vector = (0, 0, 0), angular_velocity: Vector = (0, 0, 0),
+                 velocity_given: Optional[Sequence[bool]] = None,
+                 parts: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
         """Adds a rigid body; returns its name.
 
         inertia: three principal moments or a 3 x 3 tensor about the centre of mass, body axes;
@@ -369,11 +390,19 @@ class Model(BaseModel, SpatialElements):
         global; linear_velocity (global) and angular_velocity (body axes) are the initial
         velocity. velocity_given: which of the 6 components assembly should keep (default: the
         non-zero ones).
+
+        parts: instead of mass and inertia, the parts the body is made of, each {"name",
+        "mass", "inertia" (about the part's centre, in its axes), "at" (its centre), and
+        "orientation" (its axes)} in the body's parts frame; odyn combines them. position,
+        orientation and the velocities are then the parts frame's; the body's coordinates have
+        their origin at the combined centre of mass (see `at`).
         """
         params = dict(name=name, mass=mass, inertia=inertia, position=position,
                       orientation=orientation, linear_velocity=linear_velocity,
-                      angular_velocity=angular_velocity, velocity_given=velocity_given)
-        return self._add_body(params, f"body '{name}'")
+                      angular_velocity=angular_velocity, velocity_given=velocity_given,
+                      parts=parts)
+        return self._add_body({k: v for k, v in params.items() if v is not None},
+                              f"body '{name}'")
 
 
 class PlanarModel(BaseModel, PlanarElements):
@@ -388,22 +417,29 @@ class PlanarModel(BaseModel, PlanarElements):
     space = "planar"
 
     # --- bodies -----------------------------------------------------------------------------
-    def add_body(self, name: str, mass: float, inertia: float, position: Vector = (0, 0),
-                 angle: float = 0.0, linear_velocity: Vector = (0, 0),
+    def add_body(self, name: str, mass: Optional[float] = None, inertia: Optional[float] = None,
+                 position: Vector = (0, 0), angle: float = 0.0, linear_velocity: Vector = (0, 0),
                  angular_velocity: float = 0.0,
-                 velocity_given: Optional[Sequence[bool]] = None) -> str:
+                 velocity_given: Optional[Sequence[bool]] = None,
+                 parts: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
         """Adds a planar rigid body; returns its name.
 
         inertia: moment of inertia about the centre of mass (kg m^2); zero for a point mass
-        (docs/bodies.md). position: centre of mass;
-        angle: rad, counter-clockwise (it may exceed a turn). linear_velocity and
-        angular_velocity: the initial velocity. velocity_given: which of (x', y', phi')
-        assembly should keep (default: the non-zero ones).
+        (docs/bodies.md). position: centre of mass; angle: rad, counter-clockwise (it may
+        exceed a turn). linear_velocity and angular_velocity: the initial velocity.
+        velocity_given: which of (x', y', phi') assembly should keep (default: the non-zero
+        ones).
+
+        parts: instead of mass and inertia, the parts the body is made of, each {"name",
+        "mass", "inertia" (about its centre), "at" (its centre)} in the body's parts frame;
+        odyn combines them. position, angle and the velocities are then the parts frame's; the
+        body's coordinates have their origin at the combined centre of mass (see `at`).
         """
         params = dict(name=name, mass=mass, inertia=inertia, position=position, angle=angle,
                       linear_velocity=linear_velocity, angular_velocity=angular_velocity,
-                      velocity_given=velocity_given)
-        return self._add_body(params, f"body '{name}'")
+                      velocity_given=velocity_given, parts=parts)
+        return self._add_body({k: v for k, v in params.items() if v is not None},
+                              f"body '{name}'")
 
 
 def new_model(space: str = "spatial") -> BaseModel:

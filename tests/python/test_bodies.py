@@ -113,3 +113,125 @@ def test_bodies_that_something_turns_where_they_have_no_inertia_are_refused():
     with pytest.raises(odyn.ModelError, match="plate: principal moments .* violate the "
                        "triangle inequality"):
         m.add_body("plate", 1.0, [1.0, 2.0, 0.0])
+
+
+# --- composite bodies ---------------------------------------------------------------------------
+# A pendulum of a slender rod (1.2 kg, 0.8 m) with a ball (2 kg, radius 0.1 m) at its end, the
+# parts frame's origin at the rod's top. By hand: mass 3.2 kg, centre 0.65 m down, inertia
+# about the centre 0.139 (rod) + 0.053 (ball) = 0.192 kg m^2 across, the ball's 0.008 along.
+ROD, BALL, LENGTH, RADIUS = 1.2, 2.0, 0.8, 0.1
+
+
+def pendulum_parts(space):
+    if space == "planar":
+        return [{"name": "rod", "mass": ROD, "inertia": ROD * LENGTH ** 2 / 12,
+                 "at": [0, -LENGTH / 2]},
+                {"name": "ball", "mass": BALL, "inertia": 0.4 * BALL * RADIUS ** 2,
+                 "at": [0, -LENGTH]}]
+    i_rod, i_ball = ROD * LENGTH ** 2 / 12, 0.4 * BALL * RADIUS ** 2
+    return [{"name": "rod", "mass": ROD, "inertia": [i_rod, i_rod, 0.0],
+             "at": [0, 0, -LENGTH / 2]},
+            {"name": "ball", "mass": BALL, "inertia": [i_ball] * 3, "at": [0, 0, -LENGTH]}]
+
+
+def test_a_composite_body_combines_its_parts():
+    m = odyn.Model()
+    m.add_body("pendulum", parts=pendulum_parts("spatial"))
+    body = m.body("pendulum")
+    assert body["mass"] == pytest.approx(3.2)
+    np.testing.assert_allclose(body["center_of_mass"], [0, 0, -0.65], atol=1e-15)
+    np.testing.assert_allclose(body["inertia"], np.diag([0.192, 0.192, 0.008]), atol=1e-15)
+    # Points in the parts frame and in a part's own frame, in body coordinates.
+    np.testing.assert_allclose(m.at("pendulum", [0, 0, 0]), [0, 0, 0.65], atol=1e-15)
+    np.testing.assert_allclose(m.at("pendulum", [0, 0, -0.1], part="ball"), [0, 0, -0.25],
+                               atol=1e-15)
+    # A part turned a quarter turn about z: its x axis is the frame's y.
+    q = [math.cos(math.pi / 4), 0, 0, math.sin(math.pi / 4)]
+    m.add_body("bracket", parts=[{"name": "arm", "mass": 1.0, "inertia": [0.1, 0.2, 0.25],
+                                  "at": [1, 0, 0], "orientation": q},
+                                 {"name": "nut", "mass": 1.0, "inertia": [0, 0, 0]}])
+    np.testing.assert_allclose(m.at("bracket", [0.3, 0, 0], part="arm"), [0.5, 0.3, 0],
+                               atol=1e-15)
+    # The arm's moments 0.1 about y and 0.2 about -x, and the two masses 0.5 m either side.
+    np.testing.assert_allclose(m.body("bracket")["inertia"],
+                               np.diag([0.2, 0.1 + 0.5, 0.25 + 0.5]), atol=1e-15)
+    # Two point masses make a slender rod: no inertia about the line through them.
+    m.add_body("dumbbell", parts=[{"name": "left", "mass": 1.0, "inertia": [0, 0, 0],
+                                   "at": [-0.5, 0, 0]},
+                                  {"name": "right", "mass": 1.0, "inertia": [0, 0, 0],
+                                   "at": [0.5, 0, 0]}])
+    np.testing.assert_allclose(m.body("dumbbell")["inertia"], np.diag([0, 0.5, 0.5]), atol=0)
+
+
+@pytest.mark.parametrize("space", ["spatial", "planar"])
+def test_a_composite_pendulum_swings_with_the_elliptic_period(space, tmp_path):
+    """Hinged at the parts frame's origin and released from 2 rad, it returns after
+    4 sqrt(I_p / (M g d)) K(sin^2(1)), I_p = 1.544 kg m^2 about the hinge, d = 0.65 m (also
+    from a scene file)."""
+    theta0, mass, depth = 2.0, 3.2, 0.65
+    pivot_inertia = ROD * LENGTH ** 2 / 3 + 0.4 * BALL * RADIUS ** 2 + BALL * LENGTH ** 2
+    period = 4 * math.sqrt(pivot_inertia / (mass * G * depth)) * elliptic_k(
+        math.sin(theta0 / 2) ** 2)
+    if space == "planar":
+        m = odyn.PlanarModel()
+        m.add_body("pendulum", parts=pendulum_parts(space), angle=theta0)
+        m.add_revolute("hinge", "ground", body_b="pendulum",
+                       on_b={"point": m.at("pendulum", [0, 0])})
+        m.add_gravity("gravity", [0, -G])
+    else:
+        m = odyn.Model()
+        m.add_body("pendulum", parts=pendulum_parts(space),
+                   orientation=[math.cos(theta0 / 2), 0, math.sin(theta0 / 2), 0])
+        m.add_revolute("hinge", "ground", on_a={"axis": [0, 1, 0]}, body_b="pendulum",
+                       on_b={"point": m.at("pendulum", [0, 0, 0]), "axis": [0, 1, 0]})
+        m.add_gravity("gravity", [0, 0, -G])
+    path = tmp_path / "pendulum.json"
+    settings = {"t_end": period, "output_interval": period / 2, "integrator": "dop853",
+                "rtol": 1e-11, "atol": 1e-13}
+    odyn.save(odyn.Scene(m, settings), str(path))
+    for r in (odyn.simulate(m, **settings), odyn.load(str(path)).simulate()):
+        assert not r.assembly["moved_bodies"]  # the centre of mass is where the parts put it
+        position = r.body("pendulum").position
+        # Half a period on, the centre of mass is at the mirror point; after one, back.
+        np.testing.assert_allclose(position[-1], position[0], atol=1e-8)
+        mirror = position[0] * ([-1, 1] if space == "planar" else [-1, 1, 1])
+        np.testing.assert_allclose(position[1], mirror, atol=1e-8)
+        np.testing.assert_allclose(np.linalg.norm(position[0]), depth, rtol=1e-14)
+
+
+def test_a_composite_body_takes_the_parts_frames_velocity():
+    """Given the parts frame's angular velocity about the hinge at its origin, the centre of
+    mass moves at omega x c, and the run conserves I_p omega^2 / 2 - M g d cos theta."""
+    m = odyn.Model()
+    m.add_body("pendulum", parts=pendulum_parts("spatial"), angular_velocity=[0, 2.0, 0])
+    m.add_revolute("hinge", "ground", on_a={"axis": [0, 1, 0]}, body_b="pendulum",
+                   on_b={"point": m.at("pendulum", [0, 0, 0]), "axis": [0, 1, 0]})
+    m.add_gravity("gravity", [0, 0, -G])
+    r = odyn.simulate(m, t_end=1.0, output_interval=0.1, integrator="dop853", rtol=1e-11,
+                      atol=1e-13)
+    np.testing.assert_allclose(r.body("pendulum").linear_velocity[0], [-2.0 * 0.65, 0, 0],
+                               atol=1e-12)
+    energy = r.kinetic_energy + r.potential_energy
+    np.testing.assert_allclose(energy, 0.5 * 1.544 * 4.0 - 3.2 * G * 0.65, atol=1e-9)
+
+
+@pytest.mark.parametrize("body, words", [
+    ({"mass": 1.0, "parts": [{"name": "a", "mass": 1.0, "inertia": [1, 1, 1]}]},
+     "give either mass and inertia or parts"),
+    ({"parts": []}, "expected a non-empty list of parts"),
+    ({"parts": [{"name": "a", "mass": 1.0, "inertia": [1, 1, 1]},
+                {"name": "a", "mass": 1.0, "inertia": [1, 1, 1]}]}, "another part has that name"),
+    ({"parts": [{"name": "a", "mass": 1.0, "inertia": [1, -1, 1]}]}, "positive semidefinite"),
+    ({"parts": [{"name": "a", "mass": 1.0, "inertia": [1, 1, 3]}]}, "triangle inequality"),
+    ({"parts": [{"name": "a", "inertia": [1, 1, 1]}]}, "missing 'mass'"),
+    ({"parts": [{"name": "a", "mass": 1.0, "inertia": [1, 1, 1], "offset": [1, 0, 0]}]},
+     "unknown key"),
+])
+def test_bad_parts_are_refused_by_name(body, words):
+    with pytest.raises(odyn.SceneError) as error:
+        odyn.Model().add_body("wheel", **body)
+    assert "wheel" in str(error.value) and words in str(error.value)
+    m = odyn.Model()
+    m.add_body("wheel", parts=[{"name": "hub", "mass": 1.0, "inertia": [1, 1, 1]}])
+    with pytest.raises(odyn.SceneError, match="'wheel' has no part named 'rim'; its parts: hub"):
+        m.at("wheel", [0, 0, 0], part="rim")

@@ -1,0 +1,140 @@
+"""Composite bodies: parts (a rod and a ball, a wheel and its hub) whose mass, centre of mass and
+inertia odyn combines into one rigid body.
+
+The parts are placed in the body's own frame, the *parts frame*: each part's centre `at` and,
+in space, its axes `orientation` relative to that frame. The body keeps the frame's axes, but
+its coordinates have their origin at the combined centre of mass, as every odyn body's do;
+`BaseModel.at` converts points from the parts frame (or from a part's own frame) into them.
+A body's `position`, `orientation` and velocities given with parts are those of the parts
+frame: odyn puts the centre of mass where the parts put it. See docs/bodies.md.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, List, Mapping, Optional, Sequence
+
+import numpy as np
+
+from . import _schema
+from ._schema import REQUIRED, SceneError, fail
+
+#: A part's keys: kind, default. The inertia is about the part's own centre, in its own axes.
+PART = {"name": REQUIRED, "mass": REQUIRED, "inertia": REQUIRED, "at": None, "orientation": None}
+PLANAR_PART = {"name": REQUIRED, "mass": REQUIRED, "inertia": REQUIRED, "at": None}
+
+
+def check_parts(x: Any, where: str, space: str) -> List[Dict[str, Any]]:
+    """The parts as given, checked and normalized: a non-empty list of {name, mass, inertia,
+    at, orientation (space only)} with unique names."""
+    if not isinstance(x, (list, tuple)) or not x:
+        fail(where, f"expected a non-empty list of parts, got {_schema._describe(x)}")
+    spec = PLANAR_PART if space == "planar" else PART
+    dim = 2 if space == "planar" else 3
+    out: List[Dict[str, Any]] = []
+    for i, given in enumerate(x):
+        w = f"{where}[{i}]"
+        d = _schema.check_keys(given, w, list(spec),
+                               [k for k, default in spec.items() if default is REQUIRED])
+        part: Dict[str, Any] = {"name": _schema.check_name(d["name"], f"{w}.name")}
+        w = f"{where}[{i}] ('{part['name']}')"
+        if any(p["name"] == part["name"] for p in out):
+            fail(f"{w}.name", "another part has that name; a body's parts need different names")
+        part["mass"] = _schema.check_number(d["mass"], f"{w}.mass", positive=True)
+        if space == "planar":
+            part["inertia"] = _schema.check_number(d["inertia"], f"{w}.inertia", minimum=0.0)
+        else:
+            part["inertia"] = _schema.check_inertia(d["inertia"], f"{w}.inertia")
+            _check_moments(np.array(part["inertia"]), f"{w}.inertia")
+        part["at"] = _schema.check_vector(d.get("at", [0.0] * dim), f"{w}.at", dim)
+        if space != "planar":
+            part["orientation"] = _schema.check_vector(d.get("orientation", [1.0, 0.0, 0.0, 0.0]),
+                                                       f"{w}.orientation", 4, nonzero=True)
+        out.append(part)
+    return out
+
+
+def _check_moments(inertia: np.ndarray, where: str) -> None:
+    """A part may be a point or a slender rod (zero moments), never less than that."""
+    if not np.allclose(inertia, inertia.T, rtol=1e-12, atol=0.0):
+        fail(where, "the inertia tensor must be symmetric")
+    moments = np.linalg.eigvalsh(inertia)
+    scale = max(moments[-1], 0.0)
+    if moments[0] < -1e-12 * scale or (scale == 0.0 and moments[0] < 0.0):
+        fail(where, f"principal moments ({_text(moments)}) kg m^2: a part's inertia must be "
+             "positive semidefinite")
+    if moments[2] > moments[0] + moments[1] + 1e-9 * moments.sum():
+        fail(where, f"principal moments ({_text(moments)}) violate the triangle inequality "
+             "J3 <= J1 + J2; no physical part has them")
+
+
+def _text(values: Sequence[float]) -> str:
+    return " ".join(f"{v:g}" for v in values)
+
+
+def rotation(quaternion: Sequence[float]) -> np.ndarray:
+    """The 3 x 3 rotation of a quaternion (w, x, y, z), normalized."""
+    w, x, y, z = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def combine(parts: Sequence[Mapping[str, Any]], space: str) -> Dict[str, Any]:
+    """The parts' total mass, their centre of mass in the parts frame, and their inertia about
+    it in the frame's axes (Huygens-Steiner for each part's offset)."""
+    mass = sum(p["mass"] for p in parts)
+    centre = sum(p["mass"] * np.array(p["at"]) for p in parts) / mass
+    if space == "planar":
+        inertia = sum(p["inertia"] + p["mass"] * float(np.sum((np.array(p["at"]) - centre) ** 2))
+                      for p in parts)
+        return {"mass": mass, "center_of_mass": centre.tolist(), "inertia": float(inertia)}
+    total = np.zeros((3, 3))
+    for p in parts:
+        r = rotation(p["orientation"])
+        d = np.array(p["at"]) - centre
+        offset = d @ d * np.eye(3) - np.outer(d, d)
+        total += r @ np.array(p["inertia"]) @ r.T + p["mass"] * offset
+    return {"mass": mass, "center_of_mass": centre.tolist(), "inertia": total.tolist()}
+
+
+def body_at_centre(body: Mapping[str, Any], combined: Mapping[str, Any],
+                   space: str) -> Dict[str, Any]:
+    """The body as the core takes it: the combined mass and inertia, its position and velocity
+    those of the centre of mass (the given ones are the parts frame's)."""
+    centre = np.array(combined["center_of_mass"])
+    out = {k: v for k, v in body.items() if k != "parts"}
+    out["mass"], out["inertia"] = combined["mass"], combined["inertia"]
+    if space == "planar":
+        c, s = math.cos(body["angle"]), math.sin(body["angle"])
+        offset = np.array([c * centre[0] - s * centre[1], s * centre[0] + c * centre[1]])
+        spin = body["angular_velocity"] * np.array([-offset[1], offset[0]])
+    else:
+        r = rotation(body["orientation"])
+        offset = r @ centre
+        spin = r @ np.cross(body["angular_velocity"], centre)
+    out["position"] = (np.array(body["position"]) + offset).tolist()
+    out["linear_velocity"] = (np.array(body["linear_velocity"]) + spin).tolist()
+    return out
+
+
+def point_in_body(point: Sequence[float], body: str, parts: Optional[Sequence[Mapping[str, Any]]],
+                  combined: Optional[Mapping[str, Any]], part: Optional[str],
+                  space: str) -> List[float]:
+    """Body coordinates of a point given in the parts frame, or in part `part`'s own frame (its
+    centre and axes)."""
+    dim = 2 if space == "planar" else 3
+    where = f"point on '{body}'"
+    p = np.array(_schema.check_vector(point, where, dim))
+    if part is not None:
+        named = [q for q in parts or () if q["name"] == part]
+        if not named:
+            raise SceneError(f"{where}: '{body}' has no part named {part!r}; its parts: "
+                             + (", ".join(q["name"] for q in parts) if parts else
+                                "none (it was not built from parts)"))
+        if space != "planar":
+            p = rotation(named[0]["orientation"]) @ p
+        p = p + np.array(named[0]["at"])
+    if combined is not None:
+        p = p - np.array(combined["center_of_mass"])
+    return p.tolist()
