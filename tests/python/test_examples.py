@@ -175,3 +175,23 @@ def test_driveline_example_prints_its_output_speeds():
     assert lines[0].startswith("cv_joint : output speed 3.0000 to 3.0000 rad/s"), run.stdout
     # cos(30 deg) and 1 / cos(30 deg) times the input speed 3.
     assert lines[1].startswith("universal: output speed 2.5981 to 3.4641 rad/s"), run.stdout
+
+
+def test_planetary_example_meets_willis_and_the_torque_split():
+    """A 30-15-60 set with the ring braked: the carrier at omega Z_s / (Z_s + Z_r) = 10 / 3
+    rad/s, the planet on it at -(Z_s / Z_p)(omega - omega_c) = -40 / 3, the motor taking
+    T Z_s / (Z_s + Z_r) = 5 / 3 N m of the 5 N m load and the brake the other 10 / 3."""
+    run = subprocess.run([sys.executable, str(TWINS / "planetary.py"), "--teeth", "30", "15",
+                          "60", "--load", "5"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    speeds, torques = run.stdout.splitlines()
+    assert speeds.startswith("carrier speed 3.333333 rad/s (Willis: 3.333333), planet on the "
+                             "carrier -13.333333 rad/s (-13.333333)"), run.stdout
+    assert torques.startswith("motor torque 1.666667 N m (T Z_s / (Z_s + Z_r): 1.666667), "
+                              "brake torque 3.333333 N m"), run.stdout
+    # Every output, not just the means: the speeds and torques are constant to 1e-9.
+    r = odyn.simulate(twin("planetary").planetary_reduction((30, 15, 60), 10.0, 5.0), t_end=1.0,
+                      output_interval=0.05, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(r.body("carrier").angular_velocity[:, 2], 10 / 3, rtol=1e-9)
+    np.testing.assert_allclose(r.reaction("motor").torque[:, 2], 5 / 3, rtol=1e-9)
+    np.testing.assert_allclose(r.reaction("brake").torque[:, 2], 10 / 3, rtol=1e-9)
