@@ -358,9 +358,11 @@ DRIVEN_JOINTS = {space: {t: tuple(d["joints"]) for t, d in DESCRIPTIONS[space].i
 
 def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Collection[str],
                   elements: Mapping[str, Tuple[str, Dict[str, Any]]],
-                  space: str = "spatial") -> Dict[str, Any]:
+                  space: str = "spatial",
+                  points: Optional[Mapping[str, Mapping[str, Any]]] = None) -> Dict[str, Any]:
     """Normalized parameters of an element of type `kind` in `space`; `elements`: name ->
-    (type, params)."""
+    (type, params); `points`: the named points (name -> {"body", "at"}) that a point parameter
+    may name instead of giving coordinates."""
     spec = CATALOGUE[space][kind]
     kinds = SPACE_KINDS[space]
     params = {k: v for k, v in params.items() if not (k == "joint" and v is None)}
@@ -400,6 +402,7 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
             _check_coordinate(params, spec, key, joint, elements[joint][0], where)
             params[key] = {k: elements[joint][1][k] for k in ("body_a", "on_a", "body_b", "on_b")}
     check_keys(params, where, list(spec), required)
+    _resolve_points(params, spec, points or {}, where)
     out: Dict[str, Any] = {}
     for key, (param_kind, default) in spec.items():
         if key == "joint" and takes_frames:
@@ -417,6 +420,44 @@ def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Coll
     if "bodies" in out and len(set(out["bodies"])) != len(out["bodies"]):
         fail(f"{where}.bodies", "the bodies must be different")
     return out
+
+
+#: The body each point parameter lies on: a joint frame's point, a point, a sphere's centre.
+#: A point parameter may name a point (a marker) on that body instead of giving coordinates.
+POINT_BODIES = {"on_a": "body_a", "on_b": "body_b", "point_a": "body_a", "point_b": "body_b",
+                "center_a": "body_a", "center_b": "body_b", "point": "body"}
+
+
+def _resolve_points(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]],
+                    points: Mapping[str, Mapping[str, Any]], where: str) -> None:
+    """Replaces a point's name, given for a point parameter (or a joint frame's point), by its
+    coordinates on the parameter's body, which must be the point's."""
+    for key, (kind, _) in spec.items():
+        if key not in POINT_BODIES or kind not in ("frame", "vector"):
+            continue
+        value = params.get(key)
+        if kind == "frame":
+            if isinstance(value, (list, tuple)) and value and isinstance(value[0], str):
+                value = dict(zip(("point", "axis", "reference"), value))
+            if not (isinstance(value, Mapping) and isinstance(value.get("point"), str)):
+                continue
+            name, w = value["point"], f"{where}.{key}.point"
+        elif isinstance(value, str):
+            name, w = value, f"{where}.{key}"
+        else:
+            continue
+        # A plain `point` lies on the element's `body`, or on body_a where it has none (the
+        # plane of a contact).
+        body_key = POINT_BODIES[key] if POINT_BODIES[key] in spec else "body_a"
+        if name not in points:
+            fail(w, f"no point named '{name}'; points: "
+                 + (", ".join(points) or "none (add them with add_point before this element)"))
+        body = params.get(body_key)
+        if points[name]["body"] != body:
+            fail(w, f"the point '{name}' is on '{points[name]['body']}', but {key} is a point "
+                 f"on {body_key}, '{body}'")
+        at = list(points[name]["at"])
+        params[key] = {**value, "point": at} if kind == "frame" else at
 
 
 def _check_coordinate(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]], key: str,

@@ -154,7 +154,7 @@ class BaseModel:
             _schema.fail(where, f"unknown {self.space} element type '{kind}'{hint}; expected "
                          "one of " + ", ".join(catalogue))
         checked = _schema.check_element(kind, params, where, self._body_index, self._checked,
-                                        self.space)
+                                        self.space, self._points)
         if checked["name"] in self._points:
             _schema.fail(f"{where}.name", f"the name '{checked['name']}' is already used (by a "
                          "point); names must be unique")

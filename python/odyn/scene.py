@@ -349,6 +349,9 @@ def from_dict(d: Any, where: str = "") -> Scene:
         if not isinstance(b, Mapping):
             _not_object(b, f"{prefix}bodies[{i}]")
         model._add_body(b, f"{prefix}bodies[{i}]")
+    # Points before the elements, which may name them for their points.
+    for where, p in _objects(d, "points", prefix):
+        model._add_point(p, where)
     for section, kinds in sections.items():
         entries = d.get(section, [])
         if not isinstance(entries, list):
@@ -372,8 +375,6 @@ def from_dict(d: Any, where: str = "") -> Scene:
                 fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "
                      f"{', '.join(kinds)}")
             model._add(kind, {k: v for k, v in e.items() if k != "type"}, w)
-    for where, p in _objects(d, "points", prefix):
-        model._add_point(p, where)
     for where, e in _objects(d, "events", prefix):
         if "function" in e or "bodies" in e:
             fail(where, "a scene's event watches an output or a point; a function event is "

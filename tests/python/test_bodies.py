@@ -5,6 +5,7 @@ axis; a point mass swinging in the plane from 2.5 rad returns after the elliptic
 period, also from a scene file; bodies that something turns where they have no inertia are
 refused by name."""
 
+import json
 import math
 
 import numpy as np
@@ -204,8 +205,11 @@ def test_a_composite_body_takes_the_parts_frames_velocity():
     mass moves at omega x c, and the run conserves I_p omega^2 / 2 - M g d cos theta."""
     m = odyn.Model()
     m.add_body("pendulum", parts=pendulum_parts("spatial"), angular_velocity=[0, 2.0, 0])
+    # The hinge's point on the pendulum by name: a marker at the parts frame's origin.
+    m.add_point("pivot", "pendulum", m.at("pendulum", [0, 0, 0]))
     m.add_revolute("hinge", "ground", on_a={"axis": [0, 1, 0]}, body_b="pendulum",
-                   on_b={"point": m.at("pendulum", [0, 0, 0]), "axis": [0, 1, 0]})
+                   on_b={"point": "pivot", "axis": [0, 1, 0]})
+    assert m.element("hinge")["on_b"]["point"] == pytest.approx([0, 0, 0.65])
     m.add_gravity("gravity", [0, 0, -G])
     r = odyn.simulate(m, t_end=1.0, output_interval=0.1, integrator="dop853", rtol=1e-11,
                       atol=1e-13)
@@ -235,3 +239,32 @@ def test_bad_parts_are_refused_by_name(body, words):
     m.add_body("wheel", parts=[{"name": "hub", "mass": 1.0, "inertia": [1, 1, 1]}])
     with pytest.raises(odyn.SceneError, match="'wheel' has no part named 'rim'; its parts: hub"):
         m.at("wheel", [0, 0, 0], part="rim")
+
+
+def test_point_parameters_may_name_a_point_on_their_body(tmp_path):
+    """A joint frame's point, a point of a pair and a load's point given by a point's name
+    take its coordinates; a point on another body, or no such point, is refused by name. A
+    scene file may name points too (they are read before the elements)."""
+    m = odyn.Model()
+    m.add_body("arm", 1.0, [0.1, 0.1, 0.02], position=[0.5, 0, 0])
+    m.add_point("elbow", "arm", [0.5, 0, 0])
+    m.add_point("shoulder", "arm", [-0.5, 0, 0])
+    m.add_revolute("hinge", "ground", on_a=([0, 0, 0], [0, 1, 0]), body_b="arm",
+                   on_b=("shoulder", [0, 1, 0]))
+    m.add_point_force("push", "arm", [0, 0, 1.0], point="elbow")
+    assert m.element("hinge")["on_b"]["point"] == [-0.5, 0, 0]
+    assert m.element("push")["point"] == [0.5, 0, 0]
+    with pytest.raises(odyn.SceneError, match=r"tsda 'spring'\.point_a: the point 'elbow' is "
+                       "on 'arm', but point_a is a point on body_a, 'ground'"):
+        m.add_tsda("spring", "ground", point_a="elbow", body_b="arm", point_b="elbow")
+    with pytest.raises(odyn.SceneError, match=r"ball'\.point_b: no point named 'wrist'; points: "
+                       "elbow, shoulder"):
+        m.add_spherical("ball", "ground", body_b="arm", point_b="wrist")
+    scene = {"odyn": 1, "bodies": [{"name": "arm", "mass": 1.0, "inertia": [0.1, 0.1, 0.02],
+                                    "position": [0.5, 0, 0]}],
+             "points": [{"name": "shoulder", "body": "arm", "at": [-0.5, 0, 0]}],
+             "joints": [{"type": "spherical", "name": "ball", "body_a": "ground",
+                         "body_b": "arm", "point_b": "shoulder"}]}
+    path = tmp_path / "arm.json"
+    path.write_text(json.dumps(scene))
+    assert odyn.load(str(path)).model.element("ball")["point_b"] == [-0.5, 0, 0]
