@@ -387,7 +387,9 @@ TEST_CASE("A planetary gear set of couplers keeps Willis's relation", "[gears]")
   // Over 1.5 s the sun and the planet on the carrier turn about 2.4 times each.
   CHECK(std::abs(angles[0]) > 4 * pi);
   CHECK(std::abs(angles[4]) > 3 * pi);
-  // Willis: (theta_s - theta_c) / (theta_r - theta_c) = -Z_r / Z_s.
+  // The reference itself keeps Willis's relation, (theta_s - theta_c) / (theta_r - theta_c) =
+  // -Z_r / Z_s (a check of its algebra; the runs below are checked against it, and
+  // tests/python/test_gears.py checks the relation on the program's output at every step).
   CHECK((angles[0] - angles[2]) / (angles[1] - angles[2]) ==
         Approx(-P::teeth_ring / P::teeth_sun).epsilon(1e-12));
   for (const char* integrator : {"dop853", "generalized-alpha"}) {
