@@ -78,7 +78,7 @@ asan_rc=0
 (
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-  ctest --test-dir build-asan --output-on-failure
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"  # the suite in shares
 ) || asan_rc=$?
 # The sanitizer run is the longest step of CI: name the cases that cost it most.
 echo "Slowest cases under the sanitizers (seconds):"
