@@ -1,7 +1,9 @@
 """The O-DYN paper's engine (shared/specs/engine.md), the Python twin of examples/engine.cpp:
 dynamic analysis from top dead centre, a CSV of the crank angle, piston height and bearing
 reaction, and a summary. The engine is built call by call, as examples/engine_model.hpp does;
-examples/engine.json is the same model as a scene file (odyn run examples/engine.json).
+examples/engine.json is the same model as a scene file (odyn run examples/engine.json). The gas
+force is the example's own element type, compiled with the engine's models in the module
+odyn_engine (examples/python/odyn_engine.cpp), which builds the model.
 
     python examples/python/engine.py [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]
                                      [--integrator NAME] [--rho-inf R] [--rtol R] [--atol A]
@@ -15,6 +17,7 @@ import argparse
 import sys
 
 import odyn
+import odyn_engine
 
 # Columns of the C++ examples' CSV (examples/engine_cli.hpp).
 COLUMNS = ("t", "theta", "omega", "z_piston", "R_z", "phi_norm", "phid_norm")
@@ -23,7 +26,7 @@ COLUMNS = ("t", "theta", "omega", "z_piston", "R_z", "phi_norm", "phid_norm")
 def build(r=0.04, L=0.14, omega0=157.08, c_load=0.1):
     """The engine at top dead centre; only the crank's angular velocity is given."""
     x, y, z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
-    m = odyn.Model()
+    m = odyn.Model(module=odyn_engine)
     m.add_body(name="crank", mass=1.399, inertia=[1.524, 1.291, 0.836],
                angular_velocity=[omega0, 0, 0])
     m.add_body(name="rod", mass=0.253, inertia=[0.399, 0.372, 0.0349], position=[0, 0, r + L / 2])
@@ -39,7 +42,7 @@ def build(r=0.04, L=0.14, omega0=157.08, c_load=0.1):
     m.add_gravity(name="gravity", acceleration=[0, 0, -9.81])
     m.add_rsda(name="load", body_a="ground", on_a=odyn.frame([0, 0, 0], x), body_b="crank",
                on_b=odyn.frame([0, 0, 0], x), damping=c_load)
-    m.add_engine_gas_force(name="gas force", crank="crank", piston="piston", r=r, L=L)
+    m.add("engine_gas_force", name="gas force", crank="crank", piston="piston", r=r, L=L)
     return m
 
 

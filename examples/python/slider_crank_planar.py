@@ -3,7 +3,8 @@ examples/slider_crank_planar.cpp: the same geometry, masses, gas force and load 
 plane (plane x = global Y, plane y = global Z, phi = rotation about X), with the crank's and
 rod's Ixx as planar moments of inertia. 9 coordinates and 8 equations instead of 18 and 17;
 same options and CSV columns as engine.py. examples/slider_crank_planar.json is the same
-model as a scene file.
+model as a scene file. The gas force comes with the engine's models of the module odyn_engine
+(examples/python/odyn_engine.cpp).
 
     python examples/python/slider_crank_planar.py [--h STEP] [--t-end T] [--dt-out DT]
         [--out FILE] [--integrator NAME] [--rho-inf R] [--rtol R] [--atol A]
@@ -15,12 +16,13 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import odyn  # noqa: E402
+import odyn_engine  # noqa: E402
 from engine import run_command_line  # noqa: E402
 
 
 def build(r=0.04, L=0.14, omega0=157.08, c_load=0.1):
     """The planar engine at top dead centre (examples/engine_model.hpp, engine::planar)."""
-    m = odyn.PlanarModel()
+    m = odyn.PlanarModel(module=odyn_engine)
     m.add_body(name="crank", mass=1.399, inertia=1.524, angular_velocity=omega0)
     m.add_body(name="rod", mass=0.253, inertia=0.399, position=[0, r + L / 2])
     m.add_body(name="piston", mass=0.643, inertia=0.457, position=[0, r + L])
@@ -33,7 +35,7 @@ def build(r=0.04, L=0.14, omega0=157.08, c_load=0.1):
                         body_b="piston")
     m.add_gravity(name="gravity", acceleration=[0, -9.81])
     m.add_rsda(name="load", body_a="ground", body_b="crank", damping=c_load)
-    m.add_engine_gas_force(name="gas force", crank="crank", piston="piston", r=r, L=L)
+    m.add("engine_gas_force", name="gas force", crank="crank", piston="piston", r=r, L=L)
     return m
 
 

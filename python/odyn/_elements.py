@@ -671,30 +671,6 @@ class SpatialElements(_Adds):
             transition_velocity=transition_velocity, viscous=viscous, preload=preload,
             radius=radius, bending_arm=bending_arm)
 
-    def add_engine_gas_force(
-            self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
-            D: float = 0.08, C: float = 9.0, p_atm: float = 101325.0, kappa: float = 1.4,
-            p_comb: float = 3000000.0) -> str:
-        """The engine's Otto-cycle gas force on the piston along the cylinder axis (Z; y in the
-        plane), the crank angle read from the crank's rotation; events at each half turn.
-
-        name: the element's name.
-        crank: the crank, whose angle sets the cycle.
-        piston: the piston, on which the force acts.
-        r (m): crank radius.
-        L (m): connecting rod length.
-        D (m): bore.
-        C: compression ratio.
-        p_atm (Pa): atmospheric pressure.
-        kappa: ratio of specific heats.
-        p_comb (Pa): pressure rise of combustion.
-
-        Outputs (Result.output(name)): crank_angle (rad), stroke, pressure (Pa), force (N).
-        """
-        return self._add_given(
-            "engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D, C=C,
-            p_atm=p_atm, kappa=kappa, p_comb=p_comb)
-
     def add_user_force(
             self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,
             jacobians: Optional[Callable[..., Any]] = None,
@@ -1237,30 +1213,6 @@ class PlanarElements(_Adds):
             static_coefficient=static_coefficient, stribeck_velocity=stribeck_velocity,
             transition_velocity=transition_velocity, viscous=viscous, preload=preload,
             radius=radius, bending_arm=bending_arm)
-
-    def add_engine_gas_force(
-            self, name: str, crank: str, piston: str, *, r: float = 0.04, L: float = 0.14,
-            D: float = 0.08, C: float = 9.0, p_atm: float = 101325.0, kappa: float = 1.4,
-            p_comb: float = 3000000.0) -> str:
-        """The engine's Otto-cycle gas force on the piston along the cylinder axis (Z; y in the
-        plane), the crank angle read from the crank's rotation; events at each half turn.
-
-        name: the element's name.
-        crank: the crank, whose angle sets the cycle.
-        piston: the piston, on which the force acts.
-        r (m): crank radius.
-        L (m): connecting rod length.
-        D (m): bore.
-        C: compression ratio.
-        p_atm (Pa): atmospheric pressure.
-        kappa: ratio of specific heats.
-        p_comb (Pa): pressure rise of combustion.
-
-        Outputs (Result.output(name)): crank_angle (rad), stroke, pressure (Pa), force (N).
-        """
-        return self._add_given(
-            "engine_gas_force", name=name, crank=crank, piston=piston, r=r, L=L, D=D, C=C,
-            p_atm=p_atm, kappa=kappa, p_comb=p_comb)
 
     def add_user_force(
             self, name: str, bodies: Sequence[str], function: Callable[..., Any], *,

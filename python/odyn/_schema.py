@@ -321,6 +321,9 @@ def _catalogue(described: Sequence[Mapping[str, Any]], dim: int) -> Dict[str, Di
 DESCRIPTIONS = {"spatial": _catalogue(_core.element_catalogue, 3),
                 "planar": _catalogue(_core.planar_element_catalogue, 2)}
 
+#: DESCRIPTIONS and those of the modules of one's own that were registered (odyn.modules).
+KNOWN = {space: dict(described) for space, described in DESCRIPTIONS.items()}
+
 #: Every element type: parameter -> (kind, default). Names and order follow the C++ descriptions.
 ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
     t: d["spec"] for t, d in DESCRIPTIONS["spatial"].items()}
@@ -329,7 +332,7 @@ PLANAR_ELEMENTS: Dict[str, Dict[str, Tuple[str, Any]]] = {
 
 
 def _of(space: str, category: str) -> Tuple[str, ...]:
-    return tuple(t for t, d in DESCRIPTIONS[space].items() if d["category"] == category)
+    return tuple(t for t, d in KNOWN[space].items() if d["category"] == category)
 
 
 JOINTS = _of("spatial", "joint")
@@ -354,6 +357,44 @@ JOINT_KINDS = {space: {kind: tuple(types) for kind, types in kinds.items()}
 #: each space: from the descriptions.
 DRIVEN_JOINTS = {space: {t: tuple(d["joints"]) for t, d in DESCRIPTIONS[space].items()
                          if d["joints"]} for space in DESCRIPTIONS}
+
+
+#: Element types that a module of one's own compiles (odyn.modules): type -> the module's name.
+MODULE_OF: Dict[Tuple[str, str], str] = {}
+
+
+def _refresh_categories() -> None:
+    """Rebuilds the tuples of element types by category after add_descriptions."""
+    global JOINTS, PLANAR_JOINTS, DRIVERS, FORCES, PLANAR_FORCES
+    JOINTS, PLANAR_JOINTS = _of("spatial", "joint"), _of("planar", "joint")
+    DRIVERS = _of("spatial", "driver")
+    FORCES, PLANAR_FORCES = _of("spatial", "force"), _of("planar", "force")
+    SPACE_JOINTS.update(spatial=JOINTS, planar=PLANAR_JOINTS)
+    SPACE_FORCES.update(spatial=FORCES, planar=PLANAR_FORCES)
+
+
+def add_descriptions(space: str, described: Sequence[Mapping[str, Any]],
+                     joint_kinds: Mapping[str, Sequence[str]], module: str) -> None:
+    """Adds the element types a compiled module describes (its element_catalogue) to `space`'s
+    tables (not to DESCRIPTIONS, odyn's own); a type known already must be described the same way
+    (the library's own types are)."""
+    for t, d in _catalogue(described, 3 if space == "spatial" else 2).items():
+        known = KNOWN[space].get(t)
+        if known is not None:
+            if known["parameters"] != d["parameters"] or known["category"] != d["category"]:
+                owner = MODULE_OF.get((space, t), "odyn")
+                fail(f"module {module}", f"its {space} element type '{t}' differs from the one "
+                     f"of the same name in {owner}; give one of them another name")
+            continue
+        KNOWN[space][t] = d
+        CATALOGUE[space][t] = d["spec"]
+        MODULE_OF[(space, t)] = module
+        if d["joints"]:
+            DRIVEN_JOINTS[space][t] = tuple(d["joints"])
+    for kind, types in joint_kinds.items():
+        JOINT_KINDS[space][kind] = tuple(dict.fromkeys((*JOINT_KINDS[space].get(kind, ()),
+                                                        *types)))
+    _refresh_categories()
 
 
 def check_element(kind: str, params: Mapping[str, Any], where: str, bodies: Collection[str],

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-from . import _core, _schema, composite
+from . import _core, _schema, composite, modules
 from ._elements import PlanarElements, SpatialElements
 from ._schema import SceneError
 
@@ -81,13 +81,21 @@ class BaseModel:
 
     Every ``add_*`` method checks its arguments, then adds the element to the compiled model;
     errors (`odyn.ModelError`, `odyn.SceneError`) name the element and the offending value.
+
+    module: a module of one's own (or its name) that compiles models with element types of its
+    own (see `odyn.modules`); they are added with `add`. Default: odyn's own models.
     """
 
     #: "spatial" or "planar"
     space: str = "spatial"
 
-    def __init__(self) -> None:
-        self._core: Any = _core.PlanarModel() if self.space == "planar" else _core.Model()
+    def __init__(self, module: Any = None) -> None:
+        #: The compiled module whose model this is (odyn's own, or one of one's own).
+        self.module: Any = _core if module is None else modules.register(module)
+        planar = self.space == "planar"
+        self._core: Any = self.module.PlanarModel() if planar else self.module.Model()
+        self._compiled = frozenset(self.module.planar_element_types if planar
+                                   else self.module.element_types)
         self._bodies: List[Dict[str, Any]] = []
         # name -> index in body_names ("ground" is 0): lookups in constant time, so that a
         # model of many thousands of bodies is built in time linear in its size.
@@ -134,8 +142,8 @@ class BaseModel:
     # --- elements ---------------------------------------------------------------------------
     @property
     def element_types(self) -> Tuple[str, ...]:
-        """The element types this model accepts (its space's catalogue)."""
-        return tuple(_schema.CATALOGUE[self.space])
+        """The element types this model accepts (those its module compiles)."""
+        return tuple(t for t in _schema.CATALOGUE[self.space] if t in self._compiled)
 
     def add(self, type: str, **params: Any) -> str:
         """Adds an element of the given type (see `element_types`); returns its name."""
@@ -147,12 +155,20 @@ class BaseModel:
 
     def _add(self, kind: str, params: Mapping[str, Any], where: str) -> str:
         catalogue = _schema.CATALOGUE[self.space]
-        if kind not in catalogue:
+        if kind not in catalogue or kind not in self._compiled:
             other = "spatial" if self.space == "planar" else "planar"
-            hint = (f" ('{kind}' is a {other} element; this is a {self.space} model)"
-                    if kind in _schema.CATALOGUE[other] else "")
+            owner = _schema.MODULE_OF.get((self.space, kind))
+            if kind in catalogue and owner is not None:
+                hint = (f" ('{kind}' is compiled by the module {owner}: build the model as "
+                        f"odyn.{type(self).__name__}(module={owner}))")
+            elif kind in catalogue:
+                hint = f" (the module {self.module.__name__} does not compile '{kind}')"
+            elif kind in _schema.CATALOGUE[other]:
+                hint = f" ('{kind}' is a {other} element; this is a {self.space} model)"
+            else:
+                hint = ""
             _schema.fail(where, f"unknown {self.space} element type '{kind}'{hint}; expected "
-                         "one of " + ", ".join(catalogue))
+                         "one of " + ", ".join(self.element_types))
         checked = _schema.check_element(kind, params, where, self._body_index, self._checked,
                                         self.space, self._points)
         if checked["name"] in self._points:
@@ -272,7 +288,7 @@ class BaseModel:
             _schema.fail(where, f"no element named {element!r}")
         kind = self._elements[element][0]
         outputs = [o["name"] for o in
-                   _schema.DESCRIPTIONS[self.space].get(kind, {}).get("outputs", [])]
+                   _schema.KNOWN[self.space].get(kind, {}).get("outputs", [])]
         if not outputs:
             _schema.fail(where, f"'{element}' ({kind}) reports no outputs")
         return [element, _schema.check_choice(output, f"{where}[1]", outputs)]
@@ -442,10 +458,11 @@ class PlanarModel(BaseModel, PlanarElements):
                               f"body '{name}'")
 
 
-def new_model(space: str = "spatial") -> BaseModel:
-    """An empty model of the given space ("spatial" or "planar")."""
+def new_model(space: str = "spatial", module: Any = None) -> BaseModel:
+    """An empty model of the given space ("spatial" or "planar"), of odyn's own compiled
+    models or of `module`'s (see `BaseModel`)."""
     if space == "planar":
-        return PlanarModel()
+        return PlanarModel(module)
     if space == "spatial":
-        return Model()
+        return Model(module)
     raise SceneError(f"space: expected spatial or planar, got {space!r}")

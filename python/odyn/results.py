@@ -362,7 +362,7 @@ class Result:
 
     def state(self, element: str) -> Dict[str, np.ndarray]:
         """The discrete state of a stateful force at each output, field by field (see `odyn
-        elements TYPE`): spatial rsda {angle}, engine_gas_force {theta, half_turn}. A planar
+        elements TYPE`): spatial rsda {angle}; the engine's gas force {theta, half_turn}. A planar
         rsda keeps no state: its angle is a difference of body angles."""
         if element not in self._data["states"]:
             raise KeyError(f"{element}: no stateful force of that name; stateful forces: "
@@ -477,7 +477,7 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
     `RedundantConstraintsWarning`. linear_solver: as in `simulate`. The model keeps the
     assembled state until it changes: `simulate` with the same assembly settings starts from
     it instead of assembling again."""
-    data = _core.assemble(model._core, {
+    data = model.module.assemble(model._core, {
         "assembly_tolerance": tolerance, "assembly_max_iterations": max_iterations,
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
@@ -569,7 +569,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
     settings["events"] = model._event_table()
-    data = _core.simulate(model._core, settings, progress)
+    data = model.module.simulate(model._core, settings, progress)
     data["points"] = model._point_table()
     error = data.pop("error")
     if error is None:

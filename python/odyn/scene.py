@@ -4,6 +4,8 @@
       "odyn": 1,
       "description": "...",
       "space": "spatial",      (or "planar": 2-vectors, angles, planar elements)
+      "module": "odyn_engine", (optional: a module of one's own whose models compile the
+                                scene's element types; see odyn.modules)
       "bodies":  [{"name": "crank", "mass": 1.4, "inertia": [1.5, 1.3, 0.8], ...}],
       "joints":  [{"type": "revolute", "name": "bearing", "body_a": "ground",
                    "on_a": {"point": [0, 0, 0], "axis": [1, 0, 0]}, "body_b": "crank", ...}],
@@ -45,7 +47,7 @@ from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import _schema
+from . import _schema, modules
 from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
 from .model import BaseModel, Model, new_model
 from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
@@ -54,17 +56,21 @@ FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
 #: Element types written in Python (functions), which a scene file cannot hold.
 PYTHON_ONLY = ("user_force", "user_constraint")
-#: Element types by section of a scene file, for each space.
-SPACE_SECTIONS = {space: {"joints": tuple(t for t in _schema.SPACE_JOINTS[space]
-                                          if t not in PYTHON_ONLY),
-                          "drivers": _schema.DRIVERS,
-                          "forces": tuple(t for t in _schema.SPACE_FORCES[space]
-                                          if t not in PYTHON_ONLY)}
-                  for space in SPACES}
-SECTIONS = SPACE_SECTIONS["spatial"]
-TOP_KEYS = ("odyn", "description", "space", "bodies", "joints", "drivers", "forces", "points",
-            "events",
-            "analysis", "outputs", "figures")
+
+
+def space_sections(space: str, compiled: Optional[Sequence[str]] = None
+                   ) -> Dict[str, Tuple[str, ...]]:
+    """Element types by section of a scene file in a space (of those in `compiled`, if given:
+    a model's element_types)."""
+    def kept(types: Sequence[str]) -> Tuple[str, ...]:
+        return tuple(t for t in types if t not in PYTHON_ONLY
+                     and (compiled is None or t in compiled))
+    return {"joints": kept(_schema.SPACE_JOINTS[space]), "drivers": kept(_schema.DRIVERS),
+            "forces": kept(_schema.SPACE_FORCES[space])}
+
+
+TOP_KEYS = ("odyn", "description", "space", "module", "bodies", "joints", "drivers", "forces",
+            "points", "events", "analysis", "outputs", "figures")
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 # Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
 # or generalized-alpha (rho_inf 0.9) when a step is given without tolerances.
@@ -120,8 +126,10 @@ class Scene:
         if self.description:
             out["description"] = self.description
         out["space"] = self.model.space
+        if not modules.is_core(self.model.module):
+            out["module"] = self.model.module.__name__
         out["bodies"] = [_plain(b, f"bodies[{i}]") for i, b in enumerate(self.model._bodies)]
-        for section, kinds in SPACE_SECTIONS[self.model.space].items():
+        for section, kinds in space_sections(self.model.space).items():
             entries = []
             for name, (kind, params, _) in self.model._elements.items():
                 if kind in PYTHON_ONLY and section == "forces":
@@ -269,17 +277,19 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
             fail(f"{where}.element", f"no element named {name!r}")
         kind = model.element_type(name)
         outputs = [x["name"] for x in
-                   _schema.DESCRIPTIONS[model.space].get(kind, {}).get("outputs", [])]
+                   _schema.KNOWN[model.space].get(kind, {}).get("outputs", [])]
         if not outputs:
             fail(f"{where}.element", f"'{name}' ({kind}) reports no outputs")
         check_choice(d["output"], f"{where}.output", outputs)
     elif "state" in o:
         d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
         fields = {t: [f["name"] for f in e["state_fields"]]
-                  for t, e in _schema.DESCRIPTIONS[model.space].items() if e["state_fields"]}
+                  for t, e in _schema.KNOWN[model.space].items()
+                  if e["state_fields"] and t in model.element_types}
         name = d["state"]
         if name not in model.element_names or model.element_type(name) not in fields:
-            fail(f"{where}.state", f"no stateful force ({', '.join(fields)}) named {name!r}")
+            kinds = ", ".join(fields) or "none of its types"
+            fail(f"{where}.state", f"no stateful force ({kinds}) named {name!r}")
         check_choice(d["field"], f"{where}.field", fields[model.element_type(name)])
     else:
         d = check_keys(o, where, ("name", "quantity"), ("name", "quantity"))
@@ -338,8 +348,10 @@ def from_dict(d: Any, where: str = "") -> Scene:
         fail(f"{prefix}odyn", f"unsupported scene format version {d['odyn']!r}; expected "
              f"{FORMAT_VERSION}")
     space = check_choice(d.get("space", "spatial"), f"{prefix}space", SPACES)
-    sections = SPACE_SECTIONS[space]
-    model = new_model(space)
+    module = (modules.load(check_name(d["module"], f"{prefix}module"), f"{prefix}module")
+              if "module" in d else None)
+    model = new_model(space, module)
+    sections = space_sections(space, model.element_types)
     bodies = d["bodies"]
     if not isinstance(bodies, list):
         fail(f"{prefix}bodies", f"expected a list of bodies, got {type(bodies).__name__}")
@@ -368,8 +380,12 @@ def from_dict(d: Any, where: str = "") -> Scene:
                 for other, other_kinds in sections.items():
                     if kind in other_kinds:
                         hint = f" ('{kind}' belongs in '{other}')"
+                owner = _schema.MODULE_OF.get((space, kind)) if isinstance(kind, str) else None
+                if not hint and owner is not None and owner != model.module.__name__:
+                    hint = (f" ('{kind}' is compiled by the module {owner}: name it under "
+                            '"module")')
                 other_space = "spatial" if space == "planar" else "planar"
-                if not hint and kind in SPACE_SECTIONS[other_space][section]:
+                if not hint and kind in space_sections(other_space)[section]:
                     hint = (f" ('{kind}' is a {other_space} {section[:-1]}; this scene's space "
                             f"is {space})")
                 fail(f"{w}.type", f"unknown {section[:-1]} type {kind!r}{hint}; expected one of "

@@ -1,6 +1,8 @@
 // odyn._core: the analyses of the spatial model, and the integrators the library knows by name.
 
-#include "analyses.hpp"
+#include <odyn/python/analyses.hpp>
+
+#include "bindings.hpp"
 
 namespace odyn::python {
 

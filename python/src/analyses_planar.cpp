@@ -1,7 +1,9 @@
 // odyn._core: the analyses of the planar model (a unit of its own: the two models' integrators
 // compile in parallel).
 
-#include "analyses.hpp"
+#include <odyn/python/analyses.hpp>
+
+#include "bindings.hpp"
 
 namespace odyn::python {
 

@@ -573,10 +573,6 @@ def test_bushing_refuses_bad_matrices_by_name():
         m.add_bushing("mount", "ground", body_b="block", preload=[1, 2, 3])
 
 
-def test_engine_gas_force_is_covered_by_the_engine_tests():
-    covers("engine_gas_force")  # tests/python/test_engine.py checks it against the C++ example
-
-
 def test_contacts_are_covered_by_their_own_tests():
     covers("sphere_plane", "sphere_sphere", "box_plane", "capsule_plane")  # test_contact.py
 

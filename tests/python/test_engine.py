@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import odyn
+import odyn_engine
 from conftest import ENGINE_SCENE, read_csv
 
 COLUMNS = ["t", "theta", "omega", "z_piston", "R_z", "phi_norm", "phid_norm"]
@@ -46,10 +47,11 @@ def test_cli_writes_the_cpp_examples_csv(cpp_engine, tmp_path):
 
 
 def test_model_api_engine_equals_cpp(cpp_engine):
-    """The engine built call by call (the Python twin of examples/engine_model.hpp)."""
+    """The engine built call by call (the Python twin of examples/engine_model.hpp), with the
+    gas force of the module odyn_engine (examples/python/odyn_engine.cpp)."""
     r, L = 0.04, 0.14
     x, y, z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
-    m = odyn.Model()
+    m = odyn.Model(module=odyn_engine)
     m.add_body(name="crank", mass=1.399, inertia=[1.524, 1.291, 0.836],
                angular_velocity=[157.08, 0, 0])
     m.add_body(name="rod", mass=0.253, inertia=[0.399, 0.372, 0.0349], position=[0, 0, r + L / 2])
@@ -65,7 +67,7 @@ def test_model_api_engine_equals_cpp(cpp_engine):
     m.add_gravity(name="gravity", acceleration=[0, 0, -9.81])
     m.add_rsda(name="load", body_a="ground", on_a=odyn.frame([0, 0, 0], x), body_b="crank",
                on_b=odyn.frame([0, 0, 0], x), damping=0.1)
-    m.add_engine_gas_force(name="gas force", crank="crank", piston="piston")
+    m.add("engine_gas_force", name="gas force", crank="crank", piston="piston")
     res = odyn.simulate(m, t_end=1.0, step=1e-4, output_interval=1e-3)
     data = np.column_stack([
         res.t, res.state("gas force")["theta"], res.body("crank").angular_velocity[:, 0],

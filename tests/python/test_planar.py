@@ -208,10 +208,6 @@ def test_pin_in_an_inclined_slot_slides_and_spins():
     np.testing.assert_allclose(r.reaction("slot").force[-1], normal, atol=1e-8)
 
 
-def test_engine_gas_force_is_covered_by_the_slider_crank_tests():
-    covers("engine_gas_force")  # test_examples.py: the planar slider-crank against the engine
-
-
 def test_bushing_mount_modes_and_a_scene():
     # A block on a planar bushing 0.2 m from its centre, with a coupled 3 x 3 stiffness: small
     # vibrations follow the modes of (A^T K A) phi = w^2 M phi, A the map from the block's

@@ -1,10 +1,10 @@
 #pragma once
-// odyn._core: assembly and dynamic analysis, for either model of the bindings (instantiated in
-// analyses.cpp and analyses_planar.cpp). A run releases the GIL; at every output time it
-// records the state, the energies, the residuals, every constraint's reactions, every stateful
-// force's state and every element's outputs (core/outputs.hpp), then briefly takes the GIL to let
-// Python handle signals (Ctrl-C) and report progress. A run that stops early keeps what it
-// recorded.
+// Assembly and dynamic analysis from Python, for any model type of a module (odyn._core compiles
+// its two models' in python/src/analyses.cpp and analyses_planar.cpp). A run releases the GIL; at
+// every output time it records the state, the energies, the residuals, every constraint's
+// reactions, every stateful force's state and every element's outputs (core/outputs.hpp), then
+// briefly takes the GIL to let Python handle signals (Ctrl-C) and report progress. A run that stops
+// early keeps what it recorded.
 
 #include <Python.h>
 
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "bindings.hpp"
+#include <odyn/python/models.hpp>
 
 namespace odyn::python {
 

@@ -14,7 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "bindings.hpp"
+#include <odyn/python/dict_values.hpp>
+#include <odyn/python/models.hpp>
 
 namespace odyn::python {
 

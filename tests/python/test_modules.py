@@ -1,0 +1,108 @@
+"""Modules of one's own (odyn.modules): the engine's gas force is compiled in the module
+odyn_engine (examples/python/odyn_engine.cpp), not in odyn. test_engine.py and
+test_examples.py check the engine's runs through it against the C++ example; here, how the
+models of such a module are built, saved and refused."""
+
+import json
+
+import pytest
+
+import odyn
+import odyn_engine
+from conftest import ENGINE_SCENE
+
+LOADS = {"gravity", "rsda", "point_force", "point_torque", "tsda", "engine_gas_force",
+         "user_force", "user_constraint"}
+ENGINE_TYPES = {"revolute", "spherical", "universal", "translational"} | LOADS
+PLANAR_ENGINE_TYPES = {"revolute", "translational"} | LOADS
+
+
+def crank_and_piston(m):
+    m.add_body(name="crank", mass=1.4, inertia=[1.5, 1.3, 0.8])
+    m.add_body(name="piston", mass=0.6, inertia=[0.5, 0.5, 0.6], position=[0, 0, 0.18])
+
+
+def test_the_module_compiles_just_the_engines_types():
+    assert set(odyn.Model(module=odyn_engine).element_types) == ENGINE_TYPES
+    assert set(odyn.PlanarModel(module="odyn_engine").element_types) == PLANAR_ENGINE_TYPES
+    assert "engine_gas_force" not in odyn.element_types
+    assert "engine_gas_force" not in odyn.planar_element_types
+    assert odyn.Model(module=odyn_engine).module is odyn_engine
+    assert odyn.Model().module is odyn._core
+
+
+def test_odyns_own_model_sends_the_gas_force_to_its_module():
+    odyn.Model(module=odyn_engine)  # registered: odyn knows who compiles the type
+    m = odyn.Model()
+    crank_and_piston(m)
+    with pytest.raises(odyn.SceneError,
+                       match=r"unknown spatial element type 'engine_gas_force' "
+                       r"\('engine_gas_force' is compiled by the module odyn_engine: build the model as "
+                       r"odyn.Model\(module=odyn_engine\)\)"):
+        m.add("engine_gas_force", name="gas", crank="crank", piston="piston")
+
+
+def test_a_type_the_module_does_not_compile_is_refused_by_name():
+    m = odyn.Model(module=odyn_engine)
+    crank_and_piston(m)
+    expected = (r"bushing 'mount': unknown spatial element type 'bushing' \(the module "
+                r"odyn_engine does not compile 'bushing'\); expected one of .*engine_gas_force")
+    with pytest.raises(odyn.SceneError, match=expected):
+        m.add_bushing(name="mount", body_a="ground", body_b="crank")
+    assert m.element_names == []
+
+
+def test_the_modules_element_is_checked_by_its_description_and_its_constructor():
+    m = odyn.Model(module=odyn_engine)
+    crank_and_piston(m)
+    with pytest.raises(odyn.SceneError,
+                       match=r"engine_gas_force 'gas'\.bore: unknown key; expected one of name, "
+                       r"crank, piston, r, L, D, C, p_atm, kappa, p_comb"):
+        m.add("engine_gas_force", name="gas", crank="crank", piston="piston", bore=0.08)
+    with pytest.raises(odyn.SceneError, match=r"engine_gas_force 'gas'\.C: expected a positive "
+                       r"number, got -9"):
+        m.add("engine_gas_force", name="gas", crank="crank", piston="piston", C=-9)
+    # The C++ constructor's own check, thrown in the module and reported as odyn's error.
+    with pytest.raises(odyn.ModelError, match=r"gas: expected finite r > 0, L > r.*C = 0\.5"):
+        m.add("engine_gas_force", name="gas", crank="crank", piston="piston", C=0.5)
+    assert m.add("engine_gas_force", name="gas", crank="crank", piston="piston") == "gas"
+
+
+def test_a_scene_names_its_module_and_keeps_it(tmp_path):
+    scene = odyn.load(ENGINE_SCENE)
+    assert scene.model.module is odyn_engine
+    path = tmp_path / "engine.json"
+    odyn.save(scene, path)
+    assert json.loads(path.read_text())["module"] == "odyn_engine"
+    again = odyn.load(path)
+    assert again.model.module is odyn_engine
+    assert again.model.element_names == scene.model.element_names
+    # A scene of odyn's own models has no module key.
+    m = odyn.Model()
+    crank_and_piston(m)
+    odyn.save(m, tmp_path / "plain.json")
+    assert "module" not in json.loads((tmp_path / "plain.json").read_text())
+
+
+def test_a_scene_without_its_module_or_with_a_missing_one_is_refused():
+    d = json.loads(ENGINE_SCENE.read_text())
+    odyn.Model(module=odyn_engine)  # registered: odyn can name the module
+    del d["module"]
+    with pytest.raises(odyn.SceneError,
+                       match=r"forces\[2\]\.type: unknown force type 'engine_gas_force' "
+                       r"\('engine_gas_force' is compiled by the module odyn_engine: name it "
+                       r"under \"module\"\)"):
+        odyn.loads(json.dumps(d))
+    d["module"] = "no_such_odyn_module"
+    with pytest.raises(odyn.SceneError, match=r"module: cannot import the module of odyn "
+                       r"models 'no_such_odyn_module'"):
+        odyn.loads(json.dumps(d))
+
+
+def test_only_a_module_of_odyn_models_is_taken():
+    with pytest.raises(odyn.SceneError, match=r"module json: not a module of odyn models: it "
+                       r"lacks Model, PlanarModel"):
+        odyn.Model(module=json)
+    with pytest.raises(odyn.SceneError, match=r"expected a Python module of odyn models, got "
+                       r"int"):
+        odyn.Model(module=3)
