@@ -1,5 +1,5 @@
 """Command line: odyn run SCENE [options], odyn check SCENE, odyn integrators, odyn elements
-[TYPE] (also python -m odyn)."""
+[TYPE] [--planar] [--module NAME] (also python -m odyn)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ from typing import List, NoReturn, Optional, Tuple
 
 import numpy as np
 
-from . import _core, _schema
+from . import _core, _schema, modules
+from .model import new_model
 from .results import (ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Interrupted, Result,
                       chosen_integrator, integrators)
 from .scene import Scene, load, write_table
@@ -59,6 +60,8 @@ def _parser() -> argparse.ArgumentParser:
     elements = sub.add_parser("elements", help="list the element types, or one type's parameters")
     elements.add_argument("type", nargs="?", help="an element type: its parameters")
     elements.add_argument("--planar", action="store_true", help="the planar catalogue")
+    elements.add_argument("--module", metavar="NAME",
+                          help="the types a module of one's own compiles (odyn.modules)")
     return p
 
 
@@ -244,11 +247,14 @@ def _integrators() -> int:
     return 0
 
 
-def _elements(element_type: Optional[str], planar: bool) -> int:
+def _elements(element_type: Optional[str], planar: bool, module: Optional[str] = None) -> int:
     """The catalogue of a space as its elements describe themselves (docs/elements.md has it
-    all)."""
+    all), or the types a module of one's own compiles."""
     space = "planar" if planar else "spatial"
     catalogue = _schema.DESCRIPTIONS[space]
+    if module is not None:
+        compiled = new_model(space, modules.load(module, "--module")).element_types
+        catalogue = {t: _schema.KNOWN[space][t] for t in compiled}
     if element_type is None:
         for name, d in catalogue.items():
             print(f"{name:22} {d['category']:7} {d['summary']}")
@@ -288,7 +294,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         if args.command == "integrators":
             return _integrators()
         if args.command == "elements":
-            return _elements(args.type, args.planar)
+            return _elements(args.type, args.planar, args.module)
         return _run(args) if args.command == "run" else _check(args)
     except (_core.Error, ValueError, OSError) as e:
         print(f"odyn: {e}", file=sys.stderr)

@@ -4,6 +4,8 @@ test_examples.py check the engine's runs through it against the C++ example; her
 models of such a module are built, saved and refused."""
 
 import json
+import subprocess
+import sys
 
 import pytest
 
@@ -106,3 +108,23 @@ def test_only_a_module_of_odyn_models_is_taken():
     with pytest.raises(odyn.SceneError, match=r"expected a Python module of odyn models, got "
                        r"int"):
         odyn.Model(module=3)
+
+
+def test_the_command_line_lists_a_modules_types():
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "odyn", "elements", *args],
+                              capture_output=True, text=True)
+    run = cli("--module", "odyn_engine")
+    assert run.returncode == 0, run.stderr
+    listed = {line.split()[0] for line in run.stdout.splitlines()}
+    assert listed == ENGINE_TYPES
+    run = cli("engine_gas_force", "--planar", "--module", "odyn_engine")
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.startswith("engine_gas_force (planar force): The engine's Otto-cycle")
+    assert "  C                      positive; default 9.0. compression ratio" in run.stdout
+    assert "  half_turn" in run.stdout  # its state fields
+    run = cli("--module", "no_such_odyn_module")
+    assert run.returncode == 1 and run.stdout == ""
+    assert run.stderr.startswith("odyn: --module: cannot import the module of odyn models "
+                                 "'no_such_odyn_module'") and run.stderr.count("\n") == 1
+    assert "engine_gas_force" not in cli().stdout
