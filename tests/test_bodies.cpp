@@ -7,7 +7,10 @@
 // - a slender rod on a hinge across it, and a point mass on a pendulum's distance element in the
 //   plane, swing as the pendulum equations integrated here by RK4 in the one angle;
 // - a point mass welded to a swinging arm, a rod on a hinge not across it, and a point mass
-//   or a rod given a spin are refused by name.
+//   or a rod given a spin are refused by name;
+// - bodies built from parts (spatial/composite.hpp, planar/composite.hpp): their mass
+//   properties against hand-worked values, and a rod with a ball at its end, hinged at the
+//   rod's other end, swings as the compound pendulum's one-angle equation.
 
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
@@ -15,6 +18,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <odyn/odyn.hpp>
 
@@ -246,6 +250,105 @@ TEST_CASE("Point masses and rods that something turns are refused by name", "[bo
         model.add_body(
             sp::Body{.name = "plate", .mass = 1.0, .inertia = sp::Body::principal(1.0, 2.0, 0.0)}),
         Catch::Contains("plate") && Catch::Contains("triangle"));
+  }
+}
+
+TEST_CASE("A body built from parts has the parts' mass, centre and inertia", "[bodies]") {
+  // A 1 kg rod of 1 m along the parts frame's z, from the origin down, and a 0.5 kg ball (a
+  // point) at its lower end: m = 1.5 kg, the centre 2/3 m down; about it, across the rod,
+  // 1/12 + 1 (1/2 - 2/3)^2 + 0.5 (1/3)^2 = 1/6 kg m^2, and nothing about the rod's axis.
+  const sp::Composite arm("arm", {{.name = "rod",
+                                   .mass = 1.0,
+                                   .inertia = sp::Body::slender_rod(1.0, 1.0),
+                                   .at = {0.0, 0.0, -0.5}},
+                                  {.name = "ball", .mass = 0.5, .at = {0.0, 0.0, -1.0}}});
+  CHECK(arm.mass() == Approx(1.5));
+  CHECK((arm.center_of_mass() - Vector3d(0.0, 0.0, -2.0 / 3.0)).norm() < 1e-15);
+  const Eigen::Matrix3d rod_and_ball = Vector3d(1.0 / 6.0, 1.0 / 6.0, 0.0).asDiagonal();
+  CHECK((arm.inertia() - rod_and_ball).norm() < 1e-15);
+  CHECK((arm.at("ball", Vector3d::Zero()) - Vector3d(0.0, 0.0, -1.0 / 3.0)).norm() < 1e-15);
+  CHECK((arm.at(Vector3d::Zero()) - Vector3d(0.0, 0.0, 2.0 / 3.0)).norm() < 1e-15);
+
+  // A part turned a quarter turn about z swaps its x and y moments; one at (1, 2, 0) with
+  // another of equal mass at the origin adds m d^2 / 2 across the line between them.
+  const sp::Composite turned(
+      "turned",
+      {{.name = "block",
+        .mass = 2.0,
+        .inertia = sp::Body::principal(1.0, 2.0, 3.0),
+        .at = {1.0, 2.0, 0.0},
+        .orientation = Eigen::Quaterniond(Eigen::AngleAxisd(pi / 2.0, Vector3d::UnitZ()))},
+       {.name = "weight", .mass = 2.0}});
+  // Offsets +-(0.5, 1, 0) from the centre, 2 kg each: m (|d|^2 I - d d^T) summed.
+  Eigen::Matrix3d expected = Vector3d(2.0, 1.0, 3.0).asDiagonal();
+  const Vector3d d(0.5, 1.0, 0.0);
+  expected += 2.0 * 2.0 * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  CHECK((turned.inertia() - expected).norm() < 1e-14);
+  CHECK((turned.at("block", Vector3d::UnitX()) - Vector3d(0.5, 2.0, 0.0)).norm() < 1e-15);
+
+  // The body starts where its parts frame puts the centre, moving with the frame.
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Vector3d::UnitX()));
+  const Vector3d position(1.0, 2.0, 3.0), velocity(0.1, 0.0, 0.0), spin(2.0, 0.0, 0.0);
+  const sp::Body body = arm.body(position, q, velocity, spin);
+  const Vector3d centre = position + q * Vector3d(0.0, 0.0, -2.0 / 3.0);
+  CHECK((body.position - centre).norm() < 1e-15);
+  CHECK(
+      (body.linear_velocity - (velocity + q * spin.cross(Vector3d(0.0, 0.0, -2.0 / 3.0)))).norm() <
+      1e-15);
+
+  // In the plane: a 1 kg disc (0.02 kg m^2) at (0.3, 0) and a 1 kg point at (-0.3, 0).
+  const pl::Composite pair("pair", {{.name = "disc", .mass = 1.0, .inertia = 0.02, .at = {0.3, 0}},
+                                    {.name = "dot", .mass = 1.0, .at = {-0.3, 0.0}}});
+  CHECK(pair.inertia() == Approx(0.02 + 2 * 0.09));
+  CHECK(pair.center_of_mass().norm() < 1e-16);
+  const pl::Body planar = pair.body({1.0, 0.0}, pi / 2.0, Vector2d::Zero(), 3.0);
+  CHECK((planar.position - Vector2d(1.0, 0.0)).norm() < 1e-15);
+  CHECK((pair.at("disc", {0.1, 0.0}) - Vector2d(0.4, 0.0)).norm() < 1e-15);
+
+  SECTION("bad parts are refused by name") {
+    using Parts = std::vector<sp::Part>;
+    CHECK_THROWS_WITH(sp::Composite("arm", Parts{}), Catch::Contains("at least one part"));
+    CHECK_THROWS_WITH(sp::Composite("arm", Parts{{.name = "rod", .mass = 0.0}}),
+                      Catch::Contains("arm part 'rod'") && Catch::Contains("mass > 0"));
+    CHECK_THROWS_WITH(
+        sp::Composite("arm", Parts{{.name = "a", .mass = 1.0}, {.name = "a", .mass = 1.0}}),
+        Catch::Contains("arm part 'a'") && Catch::Contains("another part has that name"));
+    CHECK_THROWS_WITH(
+        sp::Composite(
+            "arm",
+            Parts{{.name = "plate", .mass = 1.0, .inertia = sp::Body::principal(1.0, 2.0, 4.0)}}),
+        Catch::Contains("arm part 'plate'") && Catch::Contains("triangle inequality"));
+    CHECK_THROWS_WITH(arm.at("hub", Vector3d::Zero()),
+                      Catch::Contains("no part named 'hub'; its parts: rod, ball"));
+    CHECK_THROWS_WITH(pl::Composite("pair", {{.name = "disc", .mass = 1.0, .inertia = -1.0}}),
+                      Catch::Contains("pair part 'disc'") && Catch::Contains(">= 0"));
+  }
+}
+
+TEST_CASE("A rod with a ball at its end, built from parts, swings as a compound pendulum",
+          "[bodies]") {
+  // Hinged at the rod's free end (the parts frame's origin) about y: I_O theta'' = -m g d
+  // sin theta with I_O = 1/3 + 0.5 kg m^2, m = 1.5 kg, d = 2/3 m.
+  const double theta0 = 1.2, t_end = 2.0;
+  const double expected = pendulum_angle(1.5 * g * (2.0 / 3.0) / (1.0 / 3.0 + 0.5), theta0, t_end);
+  const sp::Composite arm("arm", {{.name = "rod",
+                                   .mass = 1.0,
+                                   .inertia = sp::Body::slender_rod(1.0, 1.0),
+                                   .at = {0.0, 0.0, -0.5}},
+                                  {.name = "ball", .mass = 0.5, .at = {0.0, 0.0, -1.0}}});
+  for (const char* coordinates : {"absolute", "joint"}) {
+    DYNAMIC_SECTION(coordinates) {
+      sp::DefaultModel model;
+      const auto b = model.add_body(arm.body(
+          Vector3d::Zero(), Eigen::Quaterniond(Eigen::AngleAxisd(theta0, Vector3d::UnitY()))));
+      model.add(sp::Revolute("hinge", odyn::ground, {Vector3d::Zero(), Vector3d::UnitY()}, b,
+                             {arm.at(Vector3d::Zero()), Vector3d::UnitY()}));
+      model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
+      odyn::Workspace<sp::DefaultModel> ws(model);
+      odyn::simulate(model, ws, settings_for("dop853", coordinates, t_end), [](const auto&) {});
+      const Vector3d centre = ws.frames[1].position;
+      CHECK(std::atan2(-centre.x(), -centre.z()) == Approx(expected).margin(1e-8));
+    }
   }
 }
 

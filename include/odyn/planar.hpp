@@ -12,6 +12,7 @@
 #include "odyn/forces/tsda.hpp"
 #include "odyn/planar/body.hpp"
 #include "odyn/planar/bushing.hpp"
+#include "odyn/planar/composite.hpp"
 #include "odyn/planar/distance.hpp"
 #include "odyn/planar/drivers.hpp"
 #include "odyn/planar/fixed.hpp"

@@ -10,6 +10,7 @@
 #include "odyn/forces/tsda.hpp"
 #include "odyn/spatial/body.hpp"
 #include "odyn/spatial/bushing.hpp"
+#include "odyn/spatial/composite.hpp"
 #include "odyn/spatial/cv_joint.hpp"
 #include "odyn/spatial/cylindrical.hpp"
 #include "odyn/spatial/distance.hpp"
