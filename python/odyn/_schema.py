@@ -469,15 +469,44 @@ POINT_BODIES = {"on_a": "body_a", "on_b": "body_b", "point_a": "body_a", "point_
                 "center_a": "body_a", "center_b": "body_b", "point": "body"}
 
 
+def marker_rotation(point: Mapping[str, Any], space: str) -> List[List[float]]:
+    """A marker's axes in its body's axes: the rotation of its orientation (identity if it has
+    none), 3 x 3 from a quaternion (w, x, y, z) in space, 2 x 2 from an angle in the plane."""
+    if space == "planar":
+        c, s = math.cos(point.get("orientation", 0.0)), math.sin(point.get("orientation", 0.0))
+        return [[c, -s], [s, c]]
+    q = point.get("orientation", [1.0, 0.0, 0.0, 0.0])
+    norm = math.sqrt(sum(x * x for x in q))
+    w, x, y, z = (v / norm for v in q)
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def _marker_frame(point: Mapping[str, Any]) -> Dict[str, Any]:
+    """The joint frame of a marker: its point, its z axis and x axis as the frame's axis and
+    reference in space, its x axis as the axis in the plane."""
+    at = list(point["at"])
+    if len(at) == 2:
+        r = marker_rotation(point, "planar")
+        return {"point": at, "axis": [r[0][0], r[1][0]]}
+    r = marker_rotation(point, "spatial")
+    return {"point": at, "axis": [row[2] for row in r], "reference": [row[0] for row in r]}
+
+
 def _resolve_points(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]],
                     points: Mapping[str, Mapping[str, Any]], where: str) -> None:
     """Replaces a point's name, given for a point parameter (or a joint frame's point), by its
-    coordinates on the parameter's body, which must be the point's."""
+    coordinates on the parameter's body, which must be the point's; a joint frame given as a
+    marker's name becomes the marker's point and axes."""
     for key, (kind, _) in spec.items():
         if key not in POINT_BODIES or kind not in ("frame", "vector"):
             continue
         value = params.get(key)
-        if kind == "frame":
+        whole_frame = kind == "frame" and isinstance(value, str)
+        if whole_frame:
+            name, w = value, f"{where}.{key}"
+        elif kind == "frame":
             if isinstance(value, (list, tuple)) and value and isinstance(value[0], str):
                 value = dict(zip(("point", "axis", "reference"), value))
             if not (isinstance(value, Mapping) and isinstance(value.get("point"), str)):
@@ -498,7 +527,10 @@ def _resolve_points(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]],
             fail(w, f"the point '{name}' is on '{points[name]['body']}', but {key} is a point "
                  f"on {body_key}, '{body}'")
         at = list(points[name]["at"])
-        params[key] = {**value, "point": at} if kind == "frame" else at
+        if whole_frame:
+            params[key] = _marker_frame(points[name])
+        else:
+            params[key] = {**value, "point": at} if kind == "frame" else at
 
 
 def _check_coordinate(params: Dict[str, Any], spec: Mapping[str, Tuple[str, Any]], key: str,

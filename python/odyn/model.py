@@ -183,24 +183,40 @@ class BaseModel:
         return checked["name"]
 
     # --- points ----------------------------------------------------------------------------
-    def add_point(self, name: str, body: str, at: Optional[Vector] = None) -> str:
+    def add_point(self, name: str, body: str, at: Optional[Vector] = None,
+                  orientation: Any = None) -> str:
         """Adds a named point (a marker) fixed on a body, at `at` in body coordinates (default:
         the origin, the body's centre of mass); returns its name. Results give its position,
         velocity and acceleration (`Result.point`) and its motion relative to another point
-        (`Result.relative`); scene files list points under "points" and name them in outputs."""
+        (`Result.relative`); scene files list points under "points" and name them in outputs.
+
+        orientation: the marker's axes relative to the body's, a unit quaternion (w, x, y, z)
+        in space, an angle (rad) in the plane; default: the body's axes. A joint frame given as
+        the marker's name takes its point and axes (in space its z axis is the joint's axis and
+        its x axis the reference; in the plane its x axis), and results may give motion in its
+        axes (`Result.relative(..., axes=marker)`)."""
         return self._add_point({"name": name, "body": body,
-                                **({} if at is None else {"at": at})}, f"point '{name}'")
+                                **({} if at is None else {"at": at}),
+                                **({} if orientation is None else {"orientation": orientation})},
+                               f"point '{name}'")
 
     def _add_point(self, params: Mapping[str, Any], where: str) -> str:
         dim = 2 if self.space == "planar" else 3
-        d = _schema.check_keys(params, where, ("name", "body", "at"), ("name", "body"))
+        d = _schema.check_keys(params, where, ("name", "body", "at", "orientation"),
+                               ("name", "body"))
         name = _schema.check_name(d["name"], f"{where}.name")
         if name in _schema.Names(self._body_index, self._elements, self._points):
             _schema.fail(f"{where}.name", f"the name '{name}' is already used; names must be "
                          "unique")
         body = _schema._body(d["body"], f"{where}.body", self._body_index)
         at = _schema.check_vector(d.get("at", [0.0] * dim), f"{where}.at", dim)
-        self._points[name] = {"name": name, "body": body, "at": at}
+        point: Dict[str, Any] = {"name": name, "body": body, "at": at}
+        if d.get("orientation") is not None:
+            point["orientation"] = (
+                _schema.check_number(d["orientation"], f"{where}.orientation")
+                if self.space == "planar" else
+                _schema.check_vector(d["orientation"], f"{where}.orientation", 4, nonzero=True))
+        self._points[name] = point
         return name
 
     @property
@@ -208,7 +224,7 @@ class BaseModel:
         return list(self._points)
 
     def point(self, name: str) -> Dict[str, Any]:
-        """The point's {"name", "body", "at"}."""
+        """The point's {"name", "body", "at"} and, for a marker with axes, its "orientation"."""
         if name not in self._points:
             raise SceneError(f"{name}: no point of that name in the model"
                              + (f"; points: {', '.join(self._points)}" if self._points else ""))
@@ -217,6 +233,12 @@ class BaseModel:
     def _point_table(self) -> Dict[str, Tuple[int, List[float]]]:
         """name -> (body index, 0 for the ground; point in body coordinates), for results."""
         return {n: (self._body_index[p["body"]], p["at"]) for n, p in self._points.items()}
+
+    def _point_axes(self) -> Dict[str, List[List[float]]]:
+        """name -> the marker's axes in body axes (a rotation), for the markers that have
+        them."""
+        return {n: _schema.marker_rotation(p, self.space) for n, p in self._points.items()
+                if "orientation" in p}
 
     # --- events ----------------------------------------------------------------------------
     def add_event(self, name: str, *, output: Optional[Sequence[str]] = None,

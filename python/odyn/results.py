@@ -159,6 +159,9 @@ class Result:
         self.interrupted = interrupted
         self._bodies: List[str] = list(data["bodies"])
         self._points: Dict[str, Tuple[int, List[float]]] = dict(data.get("points", {}))
+        # The markers with axes: name -> their axes in their body's axes.
+        self._point_axes: Dict[str, np.ndarray] = {
+            name: np.asarray(r, dtype=float) for name, r in data.get("point_axes", {}).items()}
         self.events: List[Event] = [Event(**e) for e in data.get("events", [])]
         self.ended_by: Optional[str] = data.get("ended_by")
 
@@ -295,7 +298,8 @@ class Result:
         ADAMS's DX, VX and ACCX: the position of `point` from `to`, and its velocity and
         acceleration as an observer on the body `seen_from` (the ground by default: then the
         differences of the two points' velocities and accelerations) sees them, in global axes
-        or in the axes of the body named by `axes`. A body may also be named by a point on it."""
+        or in the axes named by `axes`: a body's, or a marker's (a point with an orientation;
+        a point without one names its body's axes)."""
         motion = self.point(point)
         if to is not None:
             base = self.point(to)
@@ -318,6 +322,8 @@ class Result:
         if axes == "global":
             return motion
         rotations = self._rotations(self._body_of(axes, "axes"))
+        if axes in self._point_axes:
+            rotations = np.einsum("nij,jk->nik", rotations, self._point_axes[axes])
         return PointHistory(*(np.einsum("nji,nj->ni", rotations, m) for m in motion))
 
     def reaction(self, joint: str, side: str = "b", axes: str = "global") -> Reaction:
@@ -482,6 +488,7 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
     data["points"] = model._point_table()
+    data["point_axes"] = model._point_axes()
     result = Result(data)
     _warn(result)
     return result
@@ -571,6 +578,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     settings["events"] = model._event_table()
     data = model.module.simulate(model._core, settings, progress)
     data["points"] = model._point_table()
+    data["point_axes"] = model._point_axes()
     error = data.pop("error")
     if error is None:
         result = Result(data)

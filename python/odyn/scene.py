@@ -12,7 +12,9 @@
       "drivers": [{"type": "revolute_driver", "name": "motor", "joint": "bearing",
                    "motion": {"type": "constant_velocity", "rate": 10.0}}],
       "forces":  [{"type": "gravity", "name": "gravity", "acceleration": [0, 0, -9.81}]},
-      "points":  [{"name": "pin", "body": "crank", "at": [0, 0.05, 0]}],   (markers)
+      "points":  [{"name": "pin", "body": "crank", "at": [0, 0.05, 0]}],   (markers; with
+                 "orientation", a quaternion or a planar angle, they have axes, and a joint
+                 frame may be a marker's name)
       "events":  [{"name": "top", "point": ["pin", "position", "z"], "value": 0.05,
                    "direction": "rising", "terminal": false},
                   {"name": "stretched", "output": ["spring", "length"], "value": 0.3}],

@@ -245,3 +245,83 @@ def test_joint_coordinates_report_the_same_points_and_outputs():
         values = absolute.output(element, name)
         np.testing.assert_allclose(joint.output(element, name), values,
                                    atol=1e-8 * np.max(np.abs(values)))
+
+
+G = 9.81
+
+
+def test_a_hinge_on_markers_takes_their_axes():
+    """A bar hinged about global y through markers whose z axes are turned onto y (a quarter
+    turn about x): it swings in the x-z plane with omega^2 = 2 m g L (cos theta - cos theta0)
+    / I_O, and its centre, seen from the ground marker in the marker's axes, is at
+    (L sin theta, L cos theta, 0)."""
+    mass, inertia, length, theta0 = 1.0, 0.01, 0.8, 1.0
+    onto_y = [math.cos(-math.pi / 4), math.sin(-math.pi / 4), 0.0, 0.0]  # -90 deg about x
+    m = odyn.Model()
+    m.add_body(name="bar", mass=mass, inertia=[inertia] * 3,
+               position=[length * math.sin(theta0), 0.0, -length * math.cos(theta0)])
+    m.add_point("pivot", "ground", orientation=onto_y)
+    m.add_point("end", "bar", at=[-length * math.sin(theta0), 0.0, length * math.cos(theta0)],
+                orientation=onto_y)
+    m.add_point("centre", "bar")
+    m.add_revolute(name="hinge", body_a="ground", on_a="pivot", body_b="bar", on_b="end")
+    m.add_gravity(name="gravity", acceleration=[0.0, 0.0, -G])
+    assert m.point("end")["orientation"] == onto_y
+    r = odyn.simulate(m, t_end=1.5, output_interval=0.01, integrator="dop853", rtol=1e-10,
+                      atol=1e-12)
+    centre = r.body("bar").position
+    theta = np.arctan2(centre[:, 0], -centre[:, 2])
+    np.testing.assert_allclose(centre[:, 1], 0.0, atol=1e-9)
+    assert theta.min() < -0.9 * theta0  # it swung through
+    omega = r.body("bar").angular_velocity  # body axes: the bar turns about its y
+    np.testing.assert_allclose(omega[:, [0, 2]], 0.0, atol=1e-9)
+    i_o = inertia + mass * length ** 2
+    expected = 2 * mass * G * length * (np.cos(theta) - math.cos(theta0)) / i_o
+    np.testing.assert_allclose(omega[:, 1] ** 2, expected, atol=1e-7)
+    seen = r.relative("centre", to="pivot", axes="pivot").position
+    np.testing.assert_allclose(seen, np.column_stack(
+        [length * np.sin(theta), length * np.cos(theta), np.zeros_like(theta)]), atol=1e-9)
+    np.testing.assert_allclose(seen[0], [length * math.sin(theta0), length * math.cos(theta0),
+                                         0.0], atol=1e-12)
+
+
+def test_a_planar_slot_on_markers_takes_their_axis(tmp_path):
+    """A block in a slot along markers turned 30 degrees down from x slides down it at
+    g sin 30 without turning; in the marker's axes it moves along x only."""
+    slope = math.radians(30.0)
+    m = odyn.PlanarModel()
+    m.add_body(name="block", mass=2.0, inertia=0.1)
+    m.add_point("slot", "ground", orientation=-slope)
+    m.add_point("runner", "block", orientation=-slope)
+    m.add_translational(name="guide", body_a="ground", on_a="slot", body_b="block",
+                        on_b="runner")
+    m.add_gravity(name="gravity", acceleration=[0.0, -G])
+    path = tmp_path / "slot.json"
+    odyn.save(m, path)
+    assert json.loads(path.read_text())["points"][0]["orientation"] == -slope
+    for model in (m, odyn.load(path).model):
+        r = odyn.simulate(model, t_end=1.0, output_interval=0.1, integrator="dop853",
+                          rtol=1e-10, atol=1e-12)
+        s = 0.5 * G * math.sin(slope) * r.t ** 2
+        np.testing.assert_allclose(r.body("block").position, np.column_stack(
+            [s * math.cos(slope), -s * math.sin(slope)]), atol=1e-9)
+        np.testing.assert_allclose(r.body("block").angle, 0.0, atol=1e-12)
+        along = r.relative("runner", to="slot", axes="slot").position
+        np.testing.assert_allclose(along, np.column_stack([s, np.zeros_like(s)]), atol=1e-9)
+
+
+def test_bad_marker_axes_are_refused():
+    m = odyn.Model()
+    m.add_body(name="bar", mass=1.0, inertia=[0.01] * 3)
+    with pytest.raises(odyn.SceneError, match=r"point 'p'\.orientation: zero-length vector"):
+        m.add_point("p", "bar", orientation=[0, 0, 0, 0])
+    with pytest.raises(odyn.SceneError, match=r"point 'p'\.orientation: expected a list of 4"):
+        m.add_point("p", "bar", orientation=0.5)
+    m.add_point("p", "bar", orientation=[1, 0, 0, 0])
+    with pytest.raises(odyn.SceneError, match=r"revolute 'hinge'\.on_a: the point 'p' is on "
+                       r"'bar', but on_a is a point on body_a, 'ground'"):
+        m.add_revolute(name="hinge", body_a="ground", on_a="p", body_b="bar")
+    p = odyn.PlanarModel()
+    p.add_body(name="block", mass=1.0, inertia=0.1)
+    with pytest.raises(odyn.SceneError, match=r"point 'q'\.orientation: expected a number"):
+        p.add_point("q", "block", orientation=[1, 0])
