@@ -14,6 +14,8 @@ import math
 from typing import (Any, Callable, Collection, Dict, List, Mapping, NoReturn, Optional, Sequence,
                     Tuple)
 
+import numpy as np
+
 from . import _core
 
 
@@ -469,18 +471,21 @@ POINT_BODIES = {"on_a": "body_a", "on_b": "body_b", "point_a": "body_a", "point_
                 "center_a": "body_a", "center_b": "body_b", "point": "body"}
 
 
+def rotation(quaternion: Sequence[float]) -> np.ndarray:
+    """The 3 x 3 rotation of a quaternion (w, x, y, z), normalized."""
+    w, x, y, z = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
 def marker_rotation(point: Mapping[str, Any], space: str) -> List[List[float]]:
     """A marker's axes in its body's axes: the rotation of its orientation (identity if it has
     none), 3 x 3 from a quaternion (w, x, y, z) in space, 2 x 2 from an angle in the plane."""
     if space == "planar":
         c, s = math.cos(point.get("orientation", 0.0)), math.sin(point.get("orientation", 0.0))
         return [[c, -s], [s, c]]
-    q = point.get("orientation", [1.0, 0.0, 0.0, 0.0])
-    norm = math.sqrt(sum(x * x for x in q))
-    w, x, y, z = (v / norm for v in q)
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+    return rotation(point.get("orientation", [1.0, 0.0, 0.0, 0.0])).tolist()
 
 
 def _marker_frame(point: Mapping[str, Any]) -> Dict[str, Any]:

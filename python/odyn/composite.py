@@ -72,14 +72,6 @@ def _text(values: Sequence[float]) -> str:
     return " ".join(f"{v:g}" for v in values)
 
 
-def rotation(quaternion: Sequence[float]) -> np.ndarray:
-    """The 3 x 3 rotation of a quaternion (w, x, y, z), normalized."""
-    w, x, y, z = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def combine(parts: Sequence[Mapping[str, Any]], space: str) -> Dict[str, Any]:
     """The parts' total mass, their centre of mass in the parts frame, and their inertia about
     it in the frame's axes (Huygens-Steiner for each part's offset)."""
@@ -91,7 +83,7 @@ def combine(parts: Sequence[Mapping[str, Any]], space: str) -> Dict[str, Any]:
         return {"mass": mass, "center_of_mass": centre.tolist(), "inertia": float(inertia)}
     total = np.zeros((3, 3))
     for p in parts:
-        r = rotation(p["orientation"])
+        r = _schema.rotation(p["orientation"])
         d = np.array(p["at"]) - centre
         offset = d @ d * np.eye(3) - np.outer(d, d)
         total += r @ np.array(p["inertia"]) @ r.T + p["mass"] * offset
@@ -110,7 +102,7 @@ def body_at_centre(body: Mapping[str, Any], combined: Mapping[str, Any],
         offset = np.array([c * centre[0] - s * centre[1], s * centre[0] + c * centre[1]])
         spin = body["angular_velocity"] * np.array([-offset[1], offset[0]])
     else:
-        r = rotation(body["orientation"])
+        r = _schema.rotation(body["orientation"])
         offset = r @ centre
         spin = r @ np.cross(body["angular_velocity"], centre)
     out["position"] = (np.array(body["position"]) + offset).tolist()
@@ -133,7 +125,7 @@ def point_in_body(point: Sequence[float], body: str, parts: Optional[Sequence[Ma
                              + (", ".join(q["name"] for q in parts) if parts else
                                 "none (it was not built from parts)"))
         if space != "planar":
-            p = rotation(named[0]["orientation"]) @ p
+            p = _schema.rotation(named[0]["orientation"]) @ p
         p = p + np.array(named[0]["at"])
     if combined is not None:
         p = p - np.array(combined["center_of_mass"])
