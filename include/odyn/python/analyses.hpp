@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include <odyn/python/errors.hpp>
 #include <odyn/python/models.hpp>
 
 namespace odyn::python {
@@ -357,19 +358,12 @@ inline py::dict run_summary(const RunSummary& s) {
 
 /// The Python exception object for an exception caught during a run (the GIL held).
 inline py::object python_exception(const std::exception_ptr& error) {
-  const py::module_ core = py::module_::import("odyn._core");
+  if (const auto [name, message] = odyn_error(error); name != nullptr)
+    return py::module_::import("odyn._core").attr(name)(message);
   try {
     std::rethrow_exception(error);
   } catch (py::error_already_set& e) {
     return e.value();
-  } catch (const ModelError& e) {
-    return core.attr("ModelError")(e.what());
-  } catch (const AssemblyError& e) {
-    return core.attr("AssemblyError")(e.what());
-  } catch (const SolverError& e) {
-    return core.attr("SolverError")(e.what());
-  } catch (const Error& e) {
-    return core.attr("Error")(e.what());
   } catch (const py::builtin_exception& e) {
     e.set_error();
     return py::error_already_set().value();

@@ -14,6 +14,7 @@
 #include <odyn/python/analyses.hpp>
 #include <odyn/python/catalogue.hpp>
 #include <odyn/python/dict_values.hpp>
+#include <odyn/python/errors.hpp>
 #include <odyn/python/models.hpp>
 
 namespace odyn::python {
@@ -169,19 +170,7 @@ inline void bind_errors(py::module_& m) {
   static py::exception<odyn::ModelError> model_error(m, "ModelError", error.ptr());
   static py::exception<odyn::AssemblyError> assembly_error(m, "AssemblyError", error.ptr());
   static py::exception<odyn::SolverError> solver_error(m, "SolverError", error.ptr());
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const odyn::ModelError& e) {
-      py::set_error(model_error, e.what());
-    } catch (const odyn::AssemblyError& e) {
-      py::set_error(assembly_error, e.what());
-    } catch (const odyn::SolverError& e) {
-      py::set_error(solver_error, e.what());
-    } catch (const odyn::Error& e) {
-      py::set_error(error, e.what());
-    }
-  });
+  py::register_exception_translator(&translate_odyn_error);
 }
 
 /// Registers a spatial and a planar model type on `m` as the classes Model and PlanarModel, with
@@ -204,25 +193,8 @@ void bind_model_types(py::module_& m) {
 /// For a module of one's own: the library's exceptions, thrown in its functions, become
 /// odyn._core's (odyn.ModelError and the others), which the odyn package reports.
 inline void use_odyn_errors() {
-  const py::module_ core = py::module_::import("odyn._core");
-  // Kept for the life of the process, as pybind11 keeps the classes it registers.
-  static PyObject* const error = py::object(core.attr("Error")).release().ptr();
-  static PyObject* const model_error = py::object(core.attr("ModelError")).release().ptr();
-  static PyObject* const assembly_error = py::object(core.attr("AssemblyError")).release().ptr();
-  static PyObject* const solver_error = py::object(core.attr("SolverError")).release().ptr();
-  py::register_local_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const odyn::ModelError& e) {
-      PyErr_SetString(model_error, e.what());
-    } catch (const odyn::AssemblyError& e) {
-      PyErr_SetString(assembly_error, e.what());
-    } catch (const odyn::SolverError& e) {
-      PyErr_SetString(solver_error, e.what());
-    } catch (const odyn::Error& e) {
-      PyErr_SetString(error, e.what());
-    }
-  });
+  py::module_::import("odyn._core");  // its classes exist before the first error
+  py::register_local_exception_translator(&translate_odyn_error);
 }
 
 /// Everything a module of one's own needs, in one unit (examples/python/odyn_engine.cpp): the
