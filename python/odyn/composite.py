@@ -6,12 +6,13 @@ in space, its axes `orientation` relative to that frame. The body keeps the fram
 its coordinates have their origin at the combined centre of mass, as every odyn body's do;
 `BaseModel.at` converts points from the parts frame (or from a part's own frame) into them.
 A body's `position`, `orientation` and velocities given with parts are those of the parts
-frame: odyn puts the centre of mass where the parts put it. See docs/bodies.md.
+frame: odyn puts the centre of mass where the parts put it. This module checks the parts as
+given; the C++ library's Composite combines them (odyn._core.combined_body). See
+docs/bodies.md.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
@@ -44,69 +45,13 @@ def check_parts(x: Any, where: str, space: str) -> List[Dict[str, Any]]:
         if space == "planar":
             part["inertia"] = _schema.check_number(d["inertia"], f"{w}.inertia", minimum=0.0)
         else:
+            # Its moments are checked with the combination (odyn::spatial::Composite).
             part["inertia"] = _schema.check_inertia(d["inertia"], f"{w}.inertia")
-            _check_moments(np.array(part["inertia"]), f"{w}.inertia")
         part["at"] = _schema.check_vector(d.get("at", [0.0] * dim), f"{w}.at", dim)
         if space != "planar":
             part["orientation"] = _schema.check_vector(d.get("orientation", [1.0, 0.0, 0.0, 0.0]),
                                                        f"{w}.orientation", 4, nonzero=True)
         out.append(part)
-    return out
-
-
-def _check_moments(inertia: np.ndarray, where: str) -> None:
-    """A part may be a point or a slender rod (zero moments), never less than that."""
-    if not np.allclose(inertia, inertia.T, rtol=1e-12, atol=0.0):
-        fail(where, "the inertia tensor must be symmetric")
-    moments = np.linalg.eigvalsh(inertia)
-    scale = max(moments[-1], 0.0)
-    if moments[0] < -1e-12 * scale or (scale == 0.0 and moments[0] < 0.0):
-        fail(where, f"principal moments ({_text(moments)}) kg m^2: a part's inertia must be "
-             "positive semidefinite")
-    if moments[2] > moments[0] + moments[1] + 1e-9 * moments.sum():
-        fail(where, f"principal moments ({_text(moments)}) violate the triangle inequality "
-             "J3 <= J1 + J2; no physical part has them")
-
-
-def _text(values: Sequence[float]) -> str:
-    return " ".join(f"{v:g}" for v in values)
-
-
-def combine(parts: Sequence[Mapping[str, Any]], space: str) -> Dict[str, Any]:
-    """The parts' total mass, their centre of mass in the parts frame, and their inertia about
-    it in the frame's axes (Huygens-Steiner for each part's offset)."""
-    mass = sum(p["mass"] for p in parts)
-    centre = sum(p["mass"] * np.array(p["at"]) for p in parts) / mass
-    if space == "planar":
-        inertia = sum(p["inertia"] + p["mass"] * float(np.sum((np.array(p["at"]) - centre) ** 2))
-                      for p in parts)
-        return {"mass": mass, "center_of_mass": centre.tolist(), "inertia": float(inertia)}
-    total = np.zeros((3, 3))
-    for p in parts:
-        r = _schema.rotation(p["orientation"])
-        d = np.array(p["at"]) - centre
-        offset = d @ d * np.eye(3) - np.outer(d, d)
-        total += r @ np.array(p["inertia"]) @ r.T + p["mass"] * offset
-    return {"mass": mass, "center_of_mass": centre.tolist(), "inertia": total.tolist()}
-
-
-def body_at_centre(body: Mapping[str, Any], combined: Mapping[str, Any],
-                   space: str) -> Dict[str, Any]:
-    """The body as the core takes it: the combined mass and inertia, its position and velocity
-    those of the centre of mass (the given ones are the parts frame's)."""
-    centre = np.array(combined["center_of_mass"])
-    out = {k: v for k, v in body.items() if k != "parts"}
-    out["mass"], out["inertia"] = combined["mass"], combined["inertia"]
-    if space == "planar":
-        c, s = math.cos(body["angle"]), math.sin(body["angle"])
-        offset = np.array([c * centre[0] - s * centre[1], s * centre[0] + c * centre[1]])
-        spin = body["angular_velocity"] * np.array([-offset[1], offset[0]])
-    else:
-        r = _schema.rotation(body["orientation"])
-        offset = r @ centre
-        spin = r @ np.cross(body["angular_velocity"], centre)
-    out["position"] = (np.array(body["position"]) + offset).tolist()
-    out["linear_velocity"] = (np.array(body["linear_velocity"]) + spin).tolist()
     return out
 
 

@@ -106,7 +106,8 @@ class BaseModel:
         self._checked: Dict[str, Tuple[str, Dict[str, Any]]] = {}
         # name -> {"name", "body", "at"}: the named points (markers), in the order added.
         self._points: Dict[str, Dict[str, Any]] = {}
-        # body name -> its parts combined (composite.combine), for the bodies built from parts.
+        # body name -> its parts' combined mass, inertia and centre (in the parts frame), for
+        # the bodies built from parts.
         self._composites: Dict[str, Dict[str, Any]] = {}
         # name -> the event as added and checked (see add_event), in the order added.
         self._events: Dict[str, Dict[str, Any]] = {}
@@ -115,16 +116,17 @@ class BaseModel:
         body = _schema.check_body(params, where,
                                   _schema.Names(self._body_index, self._elements, self._points),
                                   self.space)
-        combined = composite.combine(body["parts"], self.space) if "parts" in body else None
         try:
-            self._core.add_body(body if combined is None else
-                                composite.body_at_centre(body, combined, self.space))
+            # A body built from parts: odyn's Composite combines them (python/src/parts.hpp).
+            at_centre = _core.combined_body(body, self.space) if "parts" in body else body
+            self._core.add_body(at_centre)
         except _core.ModelError as e:
             raise SceneError(f"{where}: {e}") from None
         self._body_index[body["name"]] = len(self._body_index)
         self._bodies.append(body)
-        if combined is not None:
-            self._composites[body["name"]] = combined
+        if "parts" in body:
+            self._composites[body["name"]] = {
+                key: at_centre[key] for key in ("mass", "inertia", "center_of_mass")}
         return body["name"]
 
     def at(self, body: str, point: Vector, part: Optional[str] = None) -> List[float]:

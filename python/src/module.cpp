@@ -6,6 +6,7 @@
 #include <odyn/python/module.hpp>
 
 #include "bindings.hpp"
+#include "parts.hpp"
 
 PYBIND11_MODULE(_core, m) {
   using namespace odyn::python;
@@ -14,6 +15,8 @@ PYBIND11_MODULE(_core, m) {
   bind_model_types<Model, PlanarModel>(m);
   m.attr("parameter_kinds") = parameter_kind_list();
   bind_integrators(m);
+  m.def("combined_body", &combined_body, py::arg("body"), py::arg("space"),
+        "A body dict with parts, combined by odyn's Composite (odyn.composite).");
   bind_spatial_analyses(m);
   bind_planar_analyses(m);
 }
