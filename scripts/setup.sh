@@ -60,12 +60,26 @@ fi
 # --- The Python package odyn (pip install .) -----------------------------------------------------
 # Built in build-python/, so a rebuild compiles only what changed; skipped when the sources are
 # those of the last install.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
+pip_install() { .venv/bin/python -m pip install -q --disable-pip-version-check --no-build-isolation "$@"; }
 stamp=.venv/odyn-sources.sha256
-sources=$(find pyproject.toml CMakeLists.txt cmake include python examples/engine_model.hpp \
+sources=$(find pyproject.toml CMakeLists.txt cmake include python \
             -type f ! -name '*.pyc' -print0 | sort -z | xargs -0 sha256sum | sha256sum)
 if [[ ! -f $stamp || $(cat "$stamp") != "$sources" ]] || ! .venv/bin/python -c 'import odyn' 2>/dev/null; then
   echo "setup.sh: pip install . (the odyn Python package)"
-  export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-build-isolation .
+  pip_install .
+  echo "$sources" > "$stamp"
+fi
+
+# --- The engine's module odyn_engine: a module of one's own, built against the installed odyn ---
+# (examples/python/odyn_engine/), as a project outside odyn builds one. The engine's examples,
+# scene and tests use it. Rebuilt when it or odyn changed.
+stamp=.venv/odyn-engine-sources.sha256
+sources=$( (cat .venv/odyn-sources.sha256; find examples/python/odyn_engine \
+            examples/engine_model.hpp -type f -print0 | sort -z | xargs -0 sha256sum) | sha256sum)
+if [[ ! -f $stamp || $(cat "$stamp") != "$sources" ]] || ! .venv/bin/python -c 'import odyn_engine' 2>/dev/null; then
+  echo "setup.sh: pip install examples/python/odyn_engine (the engine's module)"
+  command -v ccache >/dev/null && export CMAKE_CXX_COMPILER_LAUNCHER=ccache
+  pip_install --config-settings=build-dir="$PWD/build-python/odyn_engine" examples/python/odyn_engine
   echo "$sources" > "$stamp"
 fi

@@ -3,7 +3,7 @@ dynamic analysis from top dead centre, a CSV of the crank angle, piston height a
 reaction, and a summary. The engine is built call by call, as examples/engine_model.hpp does;
 examples/engine.json is the same model as a scene file (odyn run examples/engine.json). The gas
 force is the example's own element type, compiled with the engine's models in the module
-odyn_engine (examples/python/odyn_engine.cpp), which builds the model.
+odyn_engine (examples/python/odyn_engine/odyn_engine.cpp), which builds the model.
 
     python examples/python/engine.py [--h STEP] [--t-end T] [--dt-out DT] [--out FILE]
                                      [--integrator NAME] [--rho-inf R] [--rtol R] [--atol A]

@@ -4,7 +4,7 @@ plane (plane x = global Y, plane y = global Z, phi = rotation about X), with the
 rod's Ixx as planar moments of inertia. 9 coordinates and 8 equations instead of 18 and 17;
 same options and CSV columns as engine.py. examples/slider_crank_planar.json is the same
 model as a scene file. The gas force comes with the engine's models of the module odyn_engine
-(examples/python/odyn_engine.cpp).
+(examples/python/odyn_engine/odyn_engine.cpp).
 
     python examples/python/slider_crank_planar.py [--h STEP] [--t-end T] [--dt-out DT]
         [--out FILE] [--integrator NAME] [--rho-inf R] [--rtol R] [--atol A]

@@ -22,12 +22,15 @@ odyn.integrators(): the integrators by name, with what they are.
 
 Scenes: odyn.load(path) -> Scene (model + analysis settings + outputs), odyn.save(scene, path).
 Command line: odyn run SCENE (python -m odyn run SCENE).
+Element types of one's own, compiled in a module of one's own: odyn.Model(module=...), and
+odyn.cmake_dir() for its build (docs/elements.md).
 """
 
 from . import _core
 from ._core import AssemblyError, Error, ModelError, SolverError
 from ._schema import SceneError
 from .contact import hunt_crossley_dissipation
+from .modules import cmake_dir
 from .model import (BaseModel, Model, PlanarModel, constant_velocity, frame, harmonic,
                     motion_function, polynomial)
 from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBodyHistory,
@@ -49,7 +52,7 @@ __all__ = [
     "Interrupted",
     "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
     "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
-    "ToleranceWarning", "assemble", "constant_velocity", "element_types", "frame", "harmonic",
+    "ToleranceWarning", "assemble", "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
     "hunt_crossley_dissipation", "integrators", "load", "loads", "motion_function",
     "planar_element_types", "polynomial", "save", "simulate",
 ]

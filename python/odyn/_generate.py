@@ -223,8 +223,9 @@ def elements_markdown() -> str:
         "## A module of your own",
         "",
         "An element type that is not odyn's (a law of one machine, say) needs no change to "
-        "odyn: write its header as above, then a pybind11 module that compiles models with it "
-        "(`examples/python/odyn_engine.cpp`, the engine's gas force, is one):",
+        "odyn: write its header as above, then a pybind11 module that compiles models with it. "
+        "`examples/python/odyn_engine/` is one, the engine's gas force, built outside odyn "
+        "against the installed package:",
         "",
         "```cpp",
         "#include <odyn/python/module.hpp>",
@@ -241,11 +242,18 @@ def elements_markdown() -> str:
         "`SpatialModelWith<...>` holds odyn's whole catalogue and the given types; "
         "`SpatialModelOf<...>` (and the planar twins) holds just the given types (and the "
         "elements written in Python). The integrators' instantiations dominate the build either "
-        "way: the engine's module, one unit of two small models, compiles in about 600 s here, "
-        "odyn._core's three units in about 1000 s. Build it as `python/CMakeLists.txt` builds "
-        "the engine's: `pybind11_add_module(my_models my_models.cpp)` linked to `odyn::odyn` "
-        "(outside this repository, from `find_package(odyn)`, whose headers include "
-        "`odyn/python/`); the element's description does the rest. In Python, "
+        "way: the engine's module of two small models compiles in 680 s of CPU here (two "
+        "units, 440 s on two cores), odyn._core's three units in about 1200 s.",
+        "",
+        "The odyn package carries its C++ headers and CMake package, so the module builds "
+        "against it as `examples/python/odyn_engine/` does: a `CMakeLists.txt` with "
+        "`find_package(odyn CONFIG REQUIRED)`, `find_package(pybind11 CONFIG REQUIRED)` and "
+        "`pybind11_add_module(my_models MODULE my_models.cpp)` linked to `odyn::odyn`, and a "
+        "`pyproject.toml` for scikit-build-core; `pip install --no-build-isolation .` in the "
+        "environment where odyn is installed finds both packages there. Plain CMake finds odyn "
+        "with `-Dodyn_DIR=$(python -c 'import odyn; print(odyn.cmake_dir())')`.",
+        "",
+        "The element's description does the rest. In Python, "
         "`odyn.Model(module=my_models)` (or `odyn.PlanarModel`) builds its "
         "models: `model.add(\"my_force\", ...)` checks the parameters against the description, "
         "and an element type the module does not compile is refused by name. A scene file names "

@@ -5,10 +5,12 @@ one costs no virtual call). An element type of one's own (a C++ class that descr
 docs/elements.md) reaches Python through a module of one's own that compiles models with it:
 a pybind11 module that calls ``odyn::python::bind_models`` (include/odyn/python/module.hpp).
 ``odyn.Model(module=that_module)`` then builds its models, and scene files name it under
-"module". The engine's gas force is such a type: ``examples/python/odyn_engine.cpp``.
+"module". The engine's gas force is such a type: ``examples/python/odyn_engine/``, a project
+built against the installed odyn (find_package(odyn); see cmake_dir).
 """
 
 import importlib
+import os
 from types import ModuleType
 from typing import Any, Dict
 
@@ -57,3 +59,11 @@ def load(name: str, where: str = "module") -> ModuleType:
 def is_core(module: ModuleType) -> bool:
     """True for odyn's own compiled models."""
     return module is _core
+
+
+def cmake_dir() -> str:
+    """The directory of the installed odyn's CMake package (odynConfig.cmake, with the C++
+    headers it points to): a module of one's own finds it with find_package(odyn). A
+    scikit-build-core build in the same environment finds it by itself; plain CMake is given
+    -DCMAKE_PREFIX_PATH=<this directory> (or -Dodyn_DIR=<this directory>)."""
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "share", "cmake", "odyn")

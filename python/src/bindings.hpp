@@ -2,7 +2,7 @@
 // What the translation units of odyn._core share: the two model types the module compiles (the
 // library's elements and elements written in Python) and the declarations that tie its units
 // together. The machinery is in include/odyn/python/, which a module of one's own uses the same
-// way (examples/python/odyn_engine.cpp, docs/elements.md).
+// way (examples/python/odyn_engine/odyn_engine.cpp, docs/elements.md).
 
 #include <odyn/python/models.hpp>
 

@@ -48,7 +48,7 @@ def test_cli_writes_the_cpp_examples_csv(cpp_engine, tmp_path):
 
 def test_model_api_engine_equals_cpp(cpp_engine):
     """The engine built call by call (the Python twin of examples/engine_model.hpp), with the
-    gas force of the module odyn_engine (examples/python/odyn_engine.cpp)."""
+    gas force of the module odyn_engine (examples/python/odyn_engine/odyn_engine.cpp)."""
     r, L = 0.04, 0.14
     x, y, z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
     m = odyn.Model(module=odyn_engine)

@@ -1,9 +1,11 @@
 """Modules of one's own (odyn.modules): the engine's gas force is compiled in the module
-odyn_engine (examples/python/odyn_engine.cpp), not in odyn. test_engine.py and
+odyn_engine (examples/python/odyn_engine/odyn_engine.cpp), not in odyn. test_engine.py and
 test_examples.py check the engine's runs through it against the C++ example; here, how the
 models of such a module are built, saved and refused."""
 
 import json
+import os
+import shutil
 import subprocess
 import sys
 
@@ -128,3 +130,28 @@ def test_the_command_line_lists_a_modules_types():
     assert run.stderr.startswith("odyn: --module: cannot import the module of odyn models "
                                  "'no_such_odyn_module'") and run.stderr.count("\n") == 1
     assert "engine_gas_force" not in cli().stdout
+
+
+def test_the_installed_package_carries_the_cmake_package_a_module_builds_against(tmp_path):
+    """odyn_engine was built by its own project against this installation (scripts/setup.sh);
+    here, that find_package(odyn) in a fresh project finds the headers it needs."""
+    if shutil.which("cmake") is None:
+        pytest.skip("no cmake")
+    config = os.path.join(odyn.cmake_dir(), "odynConfig.cmake")
+    assert os.path.isfile(config)
+    (tmp_path / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.20)\nproject(probe LANGUAGES CXX)\n"
+        "find_package(odyn 0.1 CONFIG REQUIRED)\n"
+        "get_target_property(dirs odyn::odyn INTERFACE_INCLUDE_DIRECTORIES)\n"
+        "message(STATUS \"odyn headers: ${dirs}\")\n")
+    run = subprocess.run(["cmake", "-S", str(tmp_path), "-B", str(tmp_path / "build"),
+                          f"-Dodyn_DIR={odyn.cmake_dir()}"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    headers = [line.split("odyn headers: ", 1)[1] for line in run.stdout.splitlines()
+               if "odyn headers: " in line]
+    assert len(headers) == 1
+    include = headers[0].split(";")[0]
+    assert os.path.isfile(os.path.join(include, "odyn", "python", "module.hpp"))
+    assert os.path.isfile(os.path.join(include, "odyn", "odyn.hpp"))
+    # The engine's module is not part of the odyn package: it was installed on its own.
+    assert os.path.dirname(odyn_engine.__file__) != os.path.dirname(odyn.__file__)

@@ -197,10 +197,10 @@ inline void use_odyn_errors() {
   py::register_local_exception_translator(&translate_odyn_error);
 }
 
-/// Everything a module of one's own needs, in one unit (examples/python/odyn_engine.cpp): the
-/// model classes of a spatial and a planar model type (each may list element types of the
-/// module's own), their analyses, and odyn's exceptions. The odyn package then builds models of
-/// them: odyn.Model(module=the_module), or "module" in a scene file.
+/// Everything a module of one's own needs, in one unit (examples/python/odyn_engine/): the model
+/// classes of a spatial and a planar model type (each may list element types of the module's
+/// own), their analyses, and odyn's exceptions. The odyn package then builds models of them:
+/// odyn.Model(module=the_module), or "module" in a scene file.
 template <class SpatialModelT, class PlanarModelT>
 void bind_models(py::module_& m) {
   use_odyn_errors();

@@ -10,30 +10,20 @@
 // engine needs (its joints, gravity, the load, and the loads and springs one adds to it; forces
 // and constraints written in Python come with every module), which shortens the module's build;
 // SpatialModelWith<engine::GasForce> would hold odyn's whole catalogue besides.
-// python/CMakeLists.txt builds it beside odyn._core.
+// Its CMakeLists.txt builds it against the installed odyn, as a project outside odyn would, in
+// two units that two cores compile side by side (odyn::python::bind_models does all in one).
 
 #include <odyn/python/module.hpp>
 
-#include "engine_model.hpp"
-
-namespace {
-
-namespace sp = odyn::spatial;
-namespace pl = odyn::planar;
-
-using SpatialEngine =
-    odyn::python::SpatialModelOf<sp::Revolute, sp::Spherical, sp::Universal, sp::Translational,
-                                 sp::Gravity, sp::Rsda, sp::PointForce, sp::PointTorque, sp::Tsda,
-                                 engine::GasForce>;
-using PlanarEngine = odyn::python::PlanarModelOf<pl::Revolute, pl::Translational, pl::Gravity,
-                                                 pl::Rsda, pl::PointForce, pl::PointTorque,
-                                                 pl::Tsda, engine::planar::GasForce>;
-
-}  // namespace
+#include "engine_models.hpp"
 
 PYBIND11_MODULE(odyn_engine, m) {
+  namespace python = odyn::python;
   m.doc() =
       "The engine example's models, with its gas force (engine_gas_force), for "
       "odyn.Model(module=odyn_engine) and odyn.PlanarModel(module=odyn_engine).";
-  odyn::python::bind_models<SpatialEngine, PlanarEngine>(m);
+  python::use_odyn_errors();
+  python::bind_model_types<engine_module::Spatial, engine_module::Planar>(m);
+  python::analysis::bind<python::ModelBox<engine_module::Spatial>>(m);
+  engine_module::bind_planar_analyses(m);  // planar_analyses.cpp
 }
