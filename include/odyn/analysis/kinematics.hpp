@@ -128,7 +128,11 @@ void solve_kinematics(const Model& model, Workspace<Model>& ws, const KinematicS
   initialize_states(model, ws);
   evaluate_forces(model, ws);
   evaluate_gamma(model, ws);
-  detail::solve_accelerations_dense(detail::dense_mass(model), jacobian, ws);
+  ws.vdot = qr.solve(ws.gamma);  // Phi_q v' = gamma, with Phi_q's factorization above
+  // Phi_q^T lambda = Q - M v' (minimum-norm where joint equations repeat each other).
+  Eigen::VectorXd inertial(model.num_velocities());
+  mass_times(model, ws.vdot, inertial);
+  ws.lambda = RankRevealingQr(jacobian.transpose(), rank_tolerance).solve(ws.force - inertial);
 }
 
 namespace detail {
