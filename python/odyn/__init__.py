@@ -37,6 +37,7 @@ from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBo
                       PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics,
                       ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
+from .statics import Modes, modes, statics
 
 #: Every element type that Model.add accepts (and scenes, except user_force and
 #: user_constraint).
@@ -50,9 +51,9 @@ __version__ = "0.1.0"
 __all__ = [
     "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Event",
     "Interrupted",
-    "Model", "ModelError", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
+    "Model", "ModelError", "Modes", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
     "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
     "ToleranceWarning", "assemble", "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
     "hunt_crossley_dissipation", "integrators", "load", "loads", "motion_function",
-    "planar_element_types", "polynomial", "save", "simulate",
+    "modes", "planar_element_types", "polynomial", "save", "simulate", "statics",
 ]

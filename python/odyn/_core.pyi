@@ -48,6 +48,14 @@ def integrators() -> List[Tuple[str, str]]:
 def assemble(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
     """Assembles; returns the recorded arrays for one output row and "assembly" (a report)."""
 
+def statics(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
+    """The static equilibrium: the recorded arrays for one output row and "statics" (its
+    summary)."""
+
+def modes(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
+    """The natural modes about the static equilibrium: the equilibrium's arrays for one output
+    row and "modes" (frequencies, shapes, the damped eigenvalues, the linearization)."""
+
 def simulate(model: Union[Model, PlanarModel], settings: Dict[str, Any],
              progress: Optional[Callable[[float], None]] = None,
              progress_interval: float = 0.2) -> Dict[str, Any]:

@@ -134,7 +134,8 @@ class Result:
     events: the model's events in time order (Event: name, time, direction, terminal);
     event_times(name); ended_by: the terminal event that ended the run, or None.
     statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
-    early); summary: the same as a dict, with the assembly report.
+    early); summary: the same as a dict, with the assembly report; statics: a static
+    equilibrium's summary (odyn.statics).
     """
 
     def __init__(self, data: Dict[str, Any], interrupted: bool = False) -> None:
@@ -164,6 +165,8 @@ class Result:
             name: np.asarray(r, dtype=float) for name, r in data.get("point_axes", {}).items()}
         self.events: List[Event] = [Event(**e) for e in data.get("events", [])]
         self.ended_by: Optional[str] = data.get("ended_by")
+        #: A static equilibrium's summary (odyn.statics), None for other analyses.
+        self.statics: Optional[Dict[str, Any]] = data.get("statics")
 
     def __len__(self) -> int:
         return len(self.t)

@@ -18,11 +18,13 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <vector>
 
 #include "odyn/analysis/constraint_projection.hpp"
 #include "odyn/analysis/minimum_norm.hpp"
 #include "odyn/analysis/saddle_point.hpp"
 #include "odyn/analysis/system.hpp"
+#include "odyn/analysis/velocity_coordinates.hpp"
 #include "odyn/core/implicit_configuration.hpp"
 #include "odyn/core/workspace.hpp"
 #include "odyn/linalg/all_finite.hpp"
@@ -57,6 +59,17 @@ class AbsoluteCoordinates {
   Eigen::Index num_positions() const { return model_.num_coordinates(); }
   Eigen::Index num_velocities() const { return model_.num_velocities(); }
   Eigen::Index num_equations() const { return model_.num_equations(); }
+
+  /// What each velocity coordinate is: a body's travel along a global axis, or its turn about
+  /// one of its own axes (its angle, in the plane).
+  std::vector<VelocityCoordinate> velocity_coordinates() const {
+    using Space = typename Model::Space;
+    std::vector<VelocityCoordinate> out;
+    for (int b = 1; b <= model_.num_bodies(); ++b)
+      for (int k = 0; k < Space::nv; ++k)
+        out.push_back({model_.body(BodyId{b}).name, Space::velocity_labels[k], k >= Space::dim});
+    return out;
+  }
 
   /// y = (q, v) of the workspace.
   void read_state(Eigen::VectorXd& y) const { y << ws_.q, ws_.v; }

@@ -74,6 +74,7 @@
 #include "odyn/analysis/sparse_kkt.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/analysis/tree_algebra.hpp"
+#include "odyn/analysis/velocity_coordinates.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/core/implicit_configuration.hpp"
 #include "odyn/core/rotation.hpp"
@@ -207,6 +208,37 @@ class JointCoordinates {
   /// Names of the joints that carry bodies (tree joints) and of those that close loops.
   const std::vector<std::string>& tree_joints() const { return tree_names_; }
   const std::vector<std::string>& loop_closures() const { return closure_names_; }
+
+  /// What each rate is: a tree joint's angle or travel (numbered where it has several), a ball
+  /// joint's turn about the child's axes, a free root's travel along a global axis or turn about
+  /// its own axes.
+  std::vector<VelocityCoordinate> velocity_coordinates() const {
+    std::vector<VelocityCoordinate> out;
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free) {
+        const std::string& body = model_.body(BodyId{node.body}).name;
+        for (int k = 0; k < Space::nv; ++k)
+          out.push_back({body, Space::velocity_labels[k], k >= Space::dim});
+      } else if (node.kind == Kind::ball) {
+        for (const char* turn : {"rx", "ry", "rz"}) out.push_back({node.joint, turn, true});
+      } else {
+        int turns = 0, travels = 0;
+        for (const Screw& screw : node.screws)
+          (screw.kind == Screw::Kind::rotation ? turns : travels) += 1;
+        int turn = 0, travel = 0;
+        for (const Screw& screw : node.screws) {
+          const bool angular = screw.kind == Screw::Kind::rotation;
+          const int number = angular ? ++turn : ++travel;
+          const bool numbered = (angular ? turns : travels) > 1;
+          out.push_back({node.joint,
+                         std::string(angular ? "angle" : "travel") +
+                             (numbered ? " " + std::to_string(number) : ""),
+                         angular});
+        }
+      }
+    }
+    return out;
+  }
 
   /// y = (joint coordinates, their rates).
   void read_state(Eigen::VectorXd& y) const { y << q_, v_; }
@@ -731,6 +763,7 @@ class JointCoordinates {
     Kind kind = Kind::screws;
     int q_offset = 0, v_offset = 0;
     std::size_t joint_type = 0, joint_index = 0;  // the tree joint: type in the model, index
+    std::string joint;                            // its name (empty for a free root)
     int child_side = 1;                           // which of its bodies this one is
     std::vector<Screw> screws;                    // a screw joint's motions
     Linear pivot = Linear::Zero();                // a ball joint's point, parent's coords
@@ -1178,6 +1211,7 @@ class JointCoordinates {
           node.joint_type = type;
           node.joint_index = edge.index;
           node.child_side = 1 - parent_side;
+          node.joint = joint.name();
           tree_names_.push_back(joint.name());
         }
       });

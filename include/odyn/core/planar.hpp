@@ -20,6 +20,8 @@ struct Planar {
   static constexpr int linear = 0;   // offset of the linear part in a body's velocity
   static constexpr int angular = 2;  // offset of the angular part
   static constexpr int nw = 1;       // size of the angular part
+  /// Names of a body's velocity numbers, for reports.
+  static constexpr std::array<const char*, nv> velocity_labels{"x", "y", "angle"};
 
   using Vector = Eigen::Vector2d;               // a point or a free vector
   using Angular = Eigen::Matrix<double, 1, 1>;  // an angular velocity or a torque

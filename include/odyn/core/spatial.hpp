@@ -22,6 +22,9 @@ struct Spatial {
   static constexpr int linear = 0;   // offset of the linear part in a body's velocity
   static constexpr int angular = 3;  // offset of the angular part
   static constexpr int nw = 3;       // size of the angular part
+  /// Names of a body's velocity numbers, for reports: travels along the global axes, turns
+  /// about the body's own.
+  static constexpr std::array<const char*, nv> velocity_labels{"x", "y", "z", "rx", "ry", "rz"};
 
   using Vector = Eigen::Vector3d;          // a point or a free vector
   using Angular = Eigen::Vector3d;         // an angular velocity or a torque

@@ -1,19 +1,24 @@
 #pragma once
-// Assembly and dynamic analysis from Python, for any model type of a module (odyn._core compiles
-// its two models' in python/src/analyses.cpp and analyses_planar.cpp). A run releases the GIL; at
-// every output time it records the state, the energies, the residuals, every constraint's
-// reactions, every stateful force's state and every element's outputs (core/outputs.hpp), then
-// briefly takes the GIL to let Python handle signals (Ctrl-C) and report progress. A run that stops
-// early keeps what it recorded.
+// Assembly, dynamic, static and modal analysis from Python, for any model type of a module
+// (odyn._core compiles its two models' in python/src/analyses.cpp and analyses_planar.cpp). A run
+// releases the GIL; at every output time it records the state, the energies, the residuals, every
+// constraint's reactions, every stateful force's state and every element's outputs
+// (core/outputs.hpp), then briefly takes the GIL to let Python handle signals (Ctrl-C) and report
+// progress. A run that stops early keeps what it recorded.
 
 #include <Python.h>
+#include <pybind11/complex.h>
 
 #include <chrono>
 #include <exception>
 #include <span>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
+#include <odyn/analysis/modes.hpp>
+#include <odyn/analysis/statics.hpp>
 #include <odyn/python/errors.hpp>
 #include <odyn/python/models.hpp>
 
@@ -56,6 +61,17 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   dp.projection_tolerance = get(d, "projection_tolerance", dp.projection_tolerance);
   s.adams.order = get(d, "order", s.adams.order);
   s.assembly = assembly_settings(d);
+  return s;
+}
+
+inline StaticSettings static_settings(const py::dict& d) {
+  StaticSettings s;
+  s.tolerance = get(d, "tolerance", s.tolerance);
+  s.max_iterations = get(d, "max_iterations", s.max_iterations);
+  s.load_stepping = get(d, "load_stepping", s.load_stepping);
+  s.max_load_steps = get(d, "max_load_steps", s.max_load_steps);
+  s.relaxation = get(d, "relaxation", s.relaxation);
+  s.coordinates = get(d, "coordinates", s.coordinates);
   return s;
 }
 
@@ -460,9 +476,91 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
   return out;
 }
 
-/// Registers assemble and simulate for one model type (pybind11 overloads by the model).
+inline py::dict static_summary(const StaticSummary& s) {
+  py::dict out;
+  out["method"] = s.method;
+  out["iterations"] = s.iterations;
+  out["load_steps"] = s.load_steps;
+  out["constraint_residual"] = s.constraint_residual;
+  out["force_residual"] = s.force_residual;
+  out["force_scale"] = s.force_scale;
+  out["length_scale"] = s.length_scale;
+  out["stable"] = s.stability.stable;
+  out["neutral"] = s.stability.neutral;
+  out["squared_frequencies"] = Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+      s.stability.squared_frequencies.data(),
+      static_cast<Eigen::Index>(s.stability.squared_frequencies.size())));
+  out["least_stiff"] = s.stability.least_stiff;
+  return out;
+}
+
+/// Runs `analysis(ws)` on a fresh workspace with the GIL released, and records the state it
+/// leaves as one output row: returns the row and what `analysis` returned.
+template <class Box, class Analysis>
+auto recorded(Box& box, Analysis&& analysis) {
+  using M = typename Box::ModelType;
+  Running<Box> running(box);
+  odyn::Workspace<M> ws(box.model);
+  Recorder<M> recorder(box.model);
+  std::decay_t<decltype(analysis(ws))> found;
+  {
+    py::gil_scoped_release release;
+    box.monitor->start();
+    found = analysis(ws);
+    recorder.record(ws);
+  }
+  return std::pair{recorder.to_python(), std::move(found)};
+}
+
+/// The static equilibrium (analysis/statics.hpp) as one output row, with its summary.
+template <class Box>
+py::dict statics(Box& box, const py::dict& settings) {
+  const StaticSettings s = static_settings(settings);
+  auto [out, summary] =
+      recorded(box, [&](auto& ws) { return odyn::static_equilibrium(box.model, ws, s); });
+  out["statics"] = static_summary(summary);
+  return out;
+}
+
+/// The natural modes about the equilibrium (analysis/modes.hpp), with the equilibrium's row.
+template <class Box>
+py::dict modes(Box& box, const py::dict& settings) {
+  ModeSettings s;
+  s.statics = static_settings(settings);
+  s.coordinates = s.statics.coordinates;
+  s.find_equilibrium = get(settings, "find_equilibrium", s.find_equilibrium);
+  auto [out, found] =
+      recorded(box, [&](auto& ws) { return odyn::natural_modes(box.model, ws, s); });
+  py::dict m;
+  m["squared_frequencies"] = found.squared_frequencies;
+  m["frequencies"] = found.frequencies;
+  m["shapes"] = found.shapes;
+  m["eigenvalues"] = found.eigenvalues;
+  m["natural_frequencies"] = found.natural_frequencies;
+  m["damped_frequencies"] = found.damped_frequencies;
+  m["damping_ratios"] = found.damping_ratios;
+  std::vector<std::string> names;
+  for (const VelocityCoordinate& c : found.coordinates) names.push_back(c.text());
+  m["coordinates"] = names;
+  const Linearization& l = found.linearization;
+  m["basis"] = l.basis;
+  m["mass"] = l.mass;
+  m["damping"] = l.damping;
+  m["stiffness"] = l.stiffness;
+  m["state_matrix"] = l.state_matrix();
+  out["modes"] = m;
+  return out;
+}
+
+/// Registers assemble, simulate, statics and modes for one model type (pybind11 overloads by
+/// the model).
 template <class Box>
 void bind(py::module_& m) {
+  m.def("statics", &statics<Box>, py::arg("model"), py::arg("settings"),
+        "Finds the static equilibrium; returns it as one output row, with its summary.");
+  m.def("modes", &modes<Box>, py::arg("model"), py::arg("settings"),
+        "Finds the natural modes about the static equilibrium; returns the equilibrium as one "
+        "output row, with the modes.");
   m.def("assemble", &assemble<Box>, py::arg("model"), py::arg("settings"),
         "Assembles the model; returns its consistent initial state as one output row.");
   m.def("simulate", &simulate<Box>, py::arg("model"), py::arg("settings"),

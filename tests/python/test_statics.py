@@ -1,0 +1,125 @@
+"""Static equilibrium and natural modes from Python (odyn.statics, odyn.modes) against closed
+forms, in absolute and joint coordinates."""
+
+import math
+
+import numpy as np
+import pytest
+
+import odyn
+
+G = 9.81
+
+
+def spring_pendulum(stiffness, rest, start):
+    """A 1 m, 1 kg bar hinged at one end, its angle from hanging down, held by a torsional
+    spring whose rest is at `rest` (its angle is zero at the start pose)."""
+    m = odyn.PlanarModel()
+    m.add_body(name="bar", mass=1.0, inertia=1.0 / 12,
+               position=[0.5 * math.sin(start), -0.5 * math.cos(start)], angle=start)
+    m.add_revolute(name="pivot", body_a="ground", body_b="bar", on_b=odyn.frame([0, 0.5]))
+    m.add_rsda(name="spring", body_a="ground", body_b="bar", stiffness=stiffness,
+               free_angle=rest - start)
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    return m
+
+
+def bisect(f, lo, hi):
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if f(mid) * f(lo) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.parametrize("coordinates", ["absolute", "joint"])
+def test_spring_pendulum_settles_where_the_moments_balance(coordinates):
+    k, rest = 10.0, 1.2
+    theta = bisect(lambda x: k * (x - rest) + G * 0.5 * math.sin(x), 0.0, rest)
+    r = odyn.statics(spring_pendulum(k, rest, 0.3), coordinates=coordinates)
+    assert len(r) == 1 and r.statics["method"] == "newton"
+    assert r.body("bar").angle[0] == pytest.approx(theta, abs=1e-12)
+    assert r.statics["constraint_residual"] <= 1e-12 and r.statics["force_residual"] <= 1e-12
+    # The hinge carries the weight (the spring is a pure torque).
+    np.testing.assert_allclose(r.reaction("pivot").force[0], [0, G], atol=1e-11)
+    assert r.statics["stable"]
+    omega2 = (k + G * 0.5 * math.cos(theta)) / (1.0 / 3)
+    assert r.statics["squared_frequencies"] == pytest.approx([omega2], rel=1e-9)
+    joint_name = "pivot.angle" if coordinates == "joint" else "bar.angle"
+    assert joint_name in r.statics["least_stiff"]
+    assert np.all(r.v == 0.0)
+
+
+def test_inverted_pendulum_with_a_soft_spring_is_flagged_unstable():
+    r = odyn.statics(spring_pendulum(3.0, math.pi, math.pi - 0.05))
+    assert r.body("bar").angle[0] == pytest.approx(math.pi, abs=1e-12)
+    assert not r.statics["stable"]
+    assert r.statics["squared_frequencies"][0] == pytest.approx((3.0 - G * 0.5) * 3, rel=1e-9)
+
+
+def test_a_free_motion_under_load_is_refused_by_name():
+    m = odyn.PlanarModel()
+    m.add_body(name="block", mass=2.0, inertia=0.1)
+    m.add_translational(name="slide", body_a="ground", on_a=odyn.frame([0, 0], [0, 1]),
+                        body_b="block")
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    with pytest.raises(odyn.SolverError, match="free motion along slide.travel"):
+        odyn.statics(m, coordinates="joint")
+    with pytest.raises(odyn.SceneError, match="coordinates: expected one of absolute, joint"):
+        odyn.statics(m, coordinates="auto")
+    with pytest.raises(odyn.SceneError, match="max_iterations"):
+        odyn.statics(m, max_iterations=0)
+
+
+@pytest.mark.parametrize("coordinates", ["absolute", "joint"])
+def test_double_pendulum_frequencies(coordinates):
+    """Two uniform bars hanging down: det(K - w^2 M) = 0 in the bars' angles."""
+    m1, l1, m2, l2 = 1.0, 1.0, 0.6, 0.8
+    d1, d2, i1, i2 = l1 / 2, l2 / 2, m1 * l1 ** 2 / 12, m2 * l2 ** 2 / 12
+    mass = np.array([[i1 + m1 * d1 ** 2 + m2 * l1 ** 2, m2 * l1 * d2],
+                     [m2 * l1 * d2, i2 + m2 * d2 ** 2]])
+    stiffness = np.diag([(m1 * d1 + m2 * l1) * G, m2 * d2 * G])
+    omega2 = np.sort(np.linalg.eigvals(np.linalg.solve(mass, stiffness)).real)
+    expected = np.sqrt(omega2) / (2 * math.pi)
+
+    m = odyn.PlanarModel()
+    m.add_body(name="upper", mass=m1, inertia=i1, position=[0, -d1])
+    m.add_body(name="lower", mass=m2, inertia=i2, position=[0, -l1 - d2])
+    m.add_revolute(name="shoulder", body_a="ground", body_b="upper", on_b=odyn.frame([0, d1]))
+    m.add_revolute(name="elbow", body_a="upper", on_a=odyn.frame([0, -d1]), body_b="lower",
+                   on_b=odyn.frame([0, d2]))
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    modes = odyn.modes(m, coordinates=coordinates)
+    assert len(modes) == 2
+    np.testing.assert_allclose(modes.frequencies, expected, rtol=1e-10)
+    np.testing.assert_allclose(modes.natural_frequencies, expected, rtol=1e-10)
+    np.testing.assert_allclose(modes.damping_ratios, 0.0, atol=1e-10)
+    assert modes.shapes.shape == (len(modes.coordinates), 2)
+    assert modes.state_matrix.shape == (4, 4) and modes.mass.shape == (2, 2)
+    # The lower mode swings both bars the same way.
+    if coordinates == "joint":
+        shoulder = modes.shape(0, "shoulder.angle")
+        assert shoulder * (shoulder + modes.shape(0, "elbow.angle")) > 0
+    else:
+        assert modes.shape(0, "upper.angle") * modes.shape(0, "lower.angle") > 0
+    with pytest.raises(odyn.SceneError, match="no coordinate 'wrist.angle'"):
+        modes.shape(0, "wrist.angle")
+    assert modes.equilibrium.body("lower").position[0] == pytest.approx([0, -l1 - d2], abs=1e-12)
+
+
+def test_damped_oscillator():
+    """A block on a slide between two spring-dampers: zeta = c_total / (2 sqrt(k_total m))."""
+    mass, k, c = 2.0, 50.0, 1.5
+    m = odyn.PlanarModel()
+    m.add_body(name="block", mass=mass, inertia=0.01, position=[1, 0])
+    m.add_translational(name="slide", body_a="ground", on_a=odyn.frame([1, 0], [1, 0]),
+                        body_b="block")
+    m.add_tsda(name="left", body_a="ground", point_a=[0, 0], body_b="block", point_b=[0, 0],
+               stiffness=k, damping=c, free_length=1.0)
+    m.add_tsda(name="right", body_a="block", point_a=[0, 0], body_b="ground", point_b=[2, 0],
+               stiffness=k, damping=c, free_length=1.0)
+    modes = odyn.modes(m, coordinates="joint", find_equilibrium=False)
+    wn, zeta = math.sqrt(2 * k / mass), 2 * c / (2 * math.sqrt(2 * k * mass))
+    assert modes.natural_frequencies[0] == pytest.approx(wn / (2 * math.pi), rel=1e-10)
+    assert modes.damping_ratios[0] == pytest.approx(zeta, rel=1e-10)
+    assert modes.eigenvalues[0].real == pytest.approx(-zeta * wn, rel=1e-10)
+    assert modes.coordinates == ["slide.travel"]
