@@ -128,6 +128,8 @@ TEST_CASE("Modes about a pose that is not an equilibrium are refused by coordina
   CHECK_THROWS_WITH(
       odyn::natural_modes(model, ws, {.find_equilibrium = false}),
       Catch::Contains("not one: a force imbalance") && Catch::Contains("on block1.x"));
+  CHECK_THROWS_WITH(odyn::natural_modes(model, ws, {.coordinates = "auto"}),
+                    Catch::Contains("coordinates 'auto' unknown"));
   // Found first, the equilibrium gives the same spectrum as without the load (linear springs).
   const odyn::Modes modes = odyn::natural_modes(model, ws);
   CHECK(modes.frequencies[0] ==

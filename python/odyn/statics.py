@@ -105,8 +105,8 @@ def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: 
           max_load_steps: int = 64, relaxation: bool = True) -> Modes:
     """The natural modes about the static equilibrium near the model's pose (found as
     `statics` finds it, with the same settings), or, with find_equilibrium=False, about the
-    pose as it is, which must then balance its loads (odyn.SolverError names the coordinate
-    that it does not). The stiffness holds the forces' and the constraints' geometric
+    pose as it is (its joints closed), which must then balance its loads (odyn.SolverError
+    names the coordinate that it does not). The stiffness holds the forces' and the constraints' geometric
     stiffness, from differences of the equations of motion; dense, for models of up to a few
     hundred coordinates. See `Modes`."""
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,

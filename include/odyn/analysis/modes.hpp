@@ -163,15 +163,23 @@ struct ModeSettings {
 };
 
 /// The natural modes about the static equilibrium near the workspace's pose (left in the
-/// workspace; see static_equilibrium), or about the pose itself (settings.find_equilibrium
-/// false). Throws SolverError when the pose is not at rest and balanced.
+/// workspace; see static_equilibrium), or about the pose itself, its joints closed
+/// (settings.find_equilibrium false). Throws SolverError when that pose is not at rest and
+/// balanced.
 template <class Model>
 Modes natural_modes(const Model& model, Workspace<Model>& ws, const ModeSettings& s = {}) {
+  if (s.coordinates != "absolute" && s.coordinates != "joint")
+    throw ModelError("modal analysis",
+                     "coordinates '" + s.coordinates + "' unknown; use 'absolute' or 'joint'");
   StaticSettings statics = s.statics;
   statics.coordinates = s.coordinates;
   if (s.find_equilibrium) {
     static_equilibrium(model, ws, statics);
   } else {
+    // The pose as given, its joints closed (assembly moves it only where they are open).
+    AssemblySettings closed;
+    closed.tolerance = std::min(statics.tolerance, 1e-10);
+    assemble_positions(model, ws, closed);
     update_frames(model, ws);
     if (ws.v.size() > 0 && ws.v.cwiseAbs().maxCoeff() > 0.0)
       throw SolverError(ws.t, "modes are found about a state at rest; this one moves (|v| = " +

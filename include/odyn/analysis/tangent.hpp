@@ -96,7 +96,7 @@ Tangent tangent(Coordinates& c, double length, Tangent::Parts parts = {}) {
   detail::residual_here(c, r0);
   const double speed_step = 1e-3 * std::max(1.0, v.cwiseAbs().maxCoeff());
   for (Eigen::Index j = 0; j < n; ++j) {
-    // Linear in v' and in v (for Phi_q v + Phi_t): unit steps are exact.
+    // r is linear in v': a unit step is exact.
     if (parts.mass) {
       c.accelerations()[j] += 1.0;
       detail::residual_here(c, r);
