@@ -28,11 +28,11 @@ bash scripts/setup.sh --no-package
 # Template instantiation makes each translation unit cost tens of seconds of CPU, so the builds
 # run side by side. The longest chain is the sanitizer build (one unity unit: its files share
 # their models and integrators) and its test run; the rest builds beside it at a lower priority,
-# one unit at a time (the Python package, then the examples), so that it fills the other core
-# without slowing that chain. One at a time, because memory is the other limit: the sanitizer
-# unit alone peaks at 13.5 GB (20.3 GB before GCC was told to collect its garbage more often,
-# see CMakeLists.txt), each other unit 3 to 4 GB, and a machine that runs out of memory does not
-# fail, it crawls.
+# one unit at a time (the Python package, the examples, then the benchmarks that CI runs), so that
+# it fills the other core without slowing that chain. One at a time, because memory is the other
+# limit: the sanitizer unit alone peaks at 13.5 GB (20.3 GB before GCC was told to collect its
+# garbage more often, see CMakeLists.txt), each other unit 3 to 4 GB, and a machine that runs out
+# of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -64,6 +64,9 @@ release_log=build/release.log
   nice -n 10 cmake --build build/downstream -j 1
   echo "Install + downstream find_package(odyn):"
   ./build/downstream/odyn_downstream
+  # The benchmarks that CI runs briefly after this script: built here, on the core that the
+  # sanitizer build leaves free (it takes about 20 min longer than this chain), not after it.
+  nice -n 10 cmake --build build -j 1 --target odyn_bench work_precision scaling
 ) >"$release_log" 2>&1 &
 release_pid=$!
 
@@ -92,8 +95,8 @@ if ((asan_rc != 0)); then
   exit "$asan_rc"
 fi
 
-section "Release examples, install + downstream find_package(odyn)"
-finish "$release_pid" "$release_log" "the Release examples or the downstream build"
+section "Release examples, install + downstream find_package(odyn), benchmarks"
+finish "$release_pid" "$release_log" "the Release examples, the downstream build or the benchmarks"
 
 section "Python package"
 finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"

@@ -19,6 +19,9 @@ elements compiled in.
     r.body("bar").angle, r.statistics.steps
 
 odyn.integrators(): the integrators by name, with what they are.
+Other analyses: odyn.kinematics (a fully driven mechanism, with the drivers' efforts),
+odyn.statics, odyn.modes; odyn.check(model) reports its degrees of freedom and redundant
+equations.
 
 Scenes: odyn.load(path) -> Scene (model + analysis settings + outputs), odyn.save(scene, path).
 Command line: odyn run SCENE (python -m odyn run SCENE).
@@ -37,6 +40,7 @@ from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBo
                       PointHistory, Reaction, RedundantConstraintsWarning, Result, Statistics,
                       ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
+from .kinematics import ModelReport, check, kinematics
 from .statics import Modes, modes, statics
 
 #: Every element type that Model.add accepts (and scenes, except user_force and
@@ -50,10 +54,10 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Event",
-    "Interrupted",
-    "Model", "ModelError", "Modes", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
-    "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
-    "ToleranceWarning", "assemble", "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
-    "hunt_crossley_dissipation", "integrators", "load", "loads", "motion_function",
+    "Interrupted", "Model", "ModelError", "ModelReport", "Modes", "PlanarBodyHistory",
+    "PlanarModel", "PointHistory", "Reaction", "RedundantConstraintsWarning", "Result", "Scene",
+    "SceneError", "SolverError", "Statistics", "ToleranceWarning", "assemble", "check",
+    "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
+    "hunt_crossley_dissipation", "integrators", "kinematics", "load", "loads", "motion_function",
     "modes", "planar_element_types", "polynomial", "save", "simulate", "statics",
 ]

@@ -48,6 +48,17 @@ def integrators() -> List[Tuple[str, str]]:
 def assemble(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
     """Assembles; returns the recorded arrays for one output row and "assembly" (a report)."""
 
+def kinematics(model: Union[Model, PlanarModel], settings: Dict[str, Any],
+               progress: Optional[Callable[[float], None]] = None,
+               progress_interval: float = 0.2) -> Dict[str, Any]:
+    """A kinematic analysis: the recorded arrays, "kinematics" (its summary, None if it stopped
+    early) and "error" (the exception that stopped it, or None)."""
+
+def check(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
+    """Assembles and reports: the recorded arrays for one output row, "assembly" (a report),
+    "given_velocities" (before assembly) and "mobility" (velocities, equations, rank,
+    redundant_equations, drivers)."""
+
 def statics(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
     """The static equilibrium: the recorded arrays for one output row and "statics" (its
     summary)."""

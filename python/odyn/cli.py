@@ -1,5 +1,5 @@
-"""Command line: odyn run SCENE [options], odyn check SCENE, odyn integrators, odyn elements
-[TYPE] [--planar] [--module NAME] (also python -m odyn)."""
+"""Command line: odyn run SCENE [--analysis KIND] [options], odyn check SCENE, odyn integrators,
+odyn elements [TYPE] [--planar] [--module NAME] (also python -m odyn)."""
 
 from __future__ import annotations
 
@@ -13,10 +13,16 @@ from typing import List, NoReturn, Optional, Tuple
 import numpy as np
 
 from . import _core, _schema, modules
+from .kinematics import check
 from .model import new_model
 from .results import (ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Interrupted, Result,
                       chosen_integrator, integrators)
-from .scene import Scene, load, write_table
+from .scene import ANALYSES, Scene, load, write_table
+from .statics import Modes
+
+
+#: The analyses that run through time (the others give one configuration).
+TIMED = ("dynamic", "kinematic")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -28,8 +34,12 @@ class _Parser(argparse.ArgumentParser):
 def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="odyn", description="Run odyn scene files (JSON).")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    run = sub.add_parser("run", help="run a scene's dynamic analysis")
+    run = sub.add_parser("run", help="run a scene's analysis (dynamic unless it names another)")
     run.add_argument("scene", help="scene file (JSON)")
+    run.add_argument("--analysis", choices=list(ANALYSES),
+                     help="dynamic, kinematic (a fully driven mechanism, with its drivers' "
+                     "efforts), static (the equilibrium) or modes (the natural modes about it); "
+                     "default: the scene's \"type\", else dynamic")
     run.add_argument("--t-end", type=float, help="end time, s")
     run.add_argument("--h", type=float, dest="step", help="step size, s")
     run.add_argument("--dt-out", type=float, dest="output_interval", help="output interval, s")
@@ -52,7 +62,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--plot", help="draw every output column against t into this image")
     run.add_argument("--figures", nargs="?", const=".", metavar="DIR",
                      help="draw the scene's figures into DIR (default: .)")
-    run.add_argument("--gif", help="animate the mechanism into this GIF file")
+    run.add_argument("--gif", help="animate the mechanism into this GIF file (modes: the "
+                     "lowest mode)")
     run.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
     check = sub.add_parser("check", help="check a scene file and describe its model")
     check.add_argument("scene")
@@ -170,26 +181,53 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
     return lines
 
 
-def _run(args: argparse.Namespace) -> int:
-    scene = load(args.scene)
-    settings = dict(scene.analysis)
-    for key in ("t_end", "step", "output_interval", "integrator", "rho_inf", "rtol", "atol",
-                "max_step", "coordinates", "linear_solver"):
+#: The options of `odyn run` that set an analysis's settings, by setting.
+_SETTING_OPTIONS = {"t_end": "--t-end", "step": "--h", "output_interval": "--dt-out",
+                    "integrator": "--integrator", "rho_inf": "--rho-inf", "rtol": "--rtol",
+                    "atol": "--atol", "max_step": "--max-step", "coordinates": "--coordinates",
+                    "linear_solver": "--linear-solver"}
+
+
+def _settings(args: argparse.Namespace, scene: Scene, kind: str) -> dict:
+    """The scene's settings for the analysis `kind`, with the command line's options."""
+    takes = set(ANALYSES[kind]) | ({"t_end", "output_interval"} if kind in TIMED else set())
+    wrong = [option for key, option in _SETTING_OPTIONS.items()
+             if getattr(args, key) is not None and key not in takes]
+    if wrong:
+        raise ValueError(f"{', '.join(wrong)}: not a setting of a {kind} analysis")
+    settings = {k: v for k, v in scene.analysis.items() if k in takes}
+    for key in _SETTING_OPTIONS:
         value = getattr(args, key)
         if value is not None:
             settings[key] = value
+    if kind != "dynamic":
+        return settings
     if chosen_integrator(settings) not in ADAPTIVE_OPTIONAL:
         settings.pop("adaptive", None)  # the scene's choice for another integrator
     elif args.rtol is not None or args.atol is not None:
         settings["adaptive"] = True  # as the C++ examples: tolerances turn on error control
+    return settings
+
+
+def _run(args: argparse.Namespace) -> int:
+    scene = load(args.scene)
+    kind = args.analysis or scene.analysis_type
+    settings = _settings(args, scene, kind)
     if args.out and not args.out.endswith((".csv", ".npz")):
         raise ValueError(f"--out {args.out}: expected a .csv or .npz file name")
+    if kind not in TIMED:
+        drawn = [o for o, v in (("--plot", args.plot), ("--figures", args.figures),
+                                ("--gif", None if kind == "modes" else args.gif))
+                 if v is not None]
+        if drawn:
+            raise ValueError(f"{', '.join(drawn)}: draws a run against time; a {kind} analysis "
+                             "gives one configuration")
+        return _run_at_rest(args, scene, kind, settings)
     progress = _Progress(settings["t_end"], not args.quiet and sys.stderr.isatty())
     start = time.monotonic()
     interrupted = False
     try:
-        result = scene.simulate(progress=progress, **{k: v for k, v in settings.items()
-                                                      if k not in ("progress",)})
+        result = scene.run(kind, progress=progress, **settings)
     except Interrupted as stop:
         result, interrupted = stop.result, True
     except _core.Error as e:
@@ -217,7 +255,9 @@ def _run(args: argparse.Namespace) -> int:
     if not args.quiet:
         target = f" -> {args.out}" if args.out else ""
         print(f"odyn: {args.scene}{target}")
-        print("\n".join(summary_lines(scene, result, settings, wall)))
+        lines = (summary_lines(scene, result, settings, wall) if kind == "dynamic"
+                 else kinematic_lines(scene, result, settings, wall))
+        print("\n".join(lines))
     if interrupted:
         print(f"odyn: interrupted; kept {len(result)} outputs up to t = "
               f"{result.t[-1] if len(result) else 0.0:g} s", file=sys.stderr)
@@ -225,19 +265,120 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _final_columns(scene: Scene, result: Result) -> List[str]:
+    final = scene.columns(result)
+    shown = [f"{k} {v[-1]:.6g}" for k, v in final.items() if k != "t"][:6]
+    return ["  final: " + ", ".join(shown)] if shown else []
+
+
+def kinematic_lines(scene: Scene, result: Result, settings: dict, wall: float) -> List[str]:
+    m = scene.model
+    lines = [f"kinematic analysis, t_end = {settings['t_end']:g} s: {len(result)} outputs"
+             + ("  [INTERRUPTED]" if result.interrupted else ""),
+             f"  {m.space} model: {m.num_velocities} coordinates, {m.num_equations} constraint "
+             f"equations, wall time {wall:.3f} s"]
+    if len(result):
+        lines.append(f"  largest residual: |Phi| {np.max(result.phi_norm):.2e}")
+        for name in result.joint_names:
+            if m.element_type(name) in _schema.DRIVERS:
+                r = result.reaction(name)
+                effort = r.force if m.element_type(name) == "translational_driver" else r.torque
+                size = np.abs(effort) if effort.ndim == 1 else np.linalg.norm(effort, axis=1)
+                unit = "N" if m.element_type(name) == "translational_driver" else "N m"
+                lines.append(f"  driver {name}: largest effort {np.max(size):.6g} {unit}")
+        lines += _final_columns(scene, result)
+    return lines
+
+
+def static_lines(scene: Scene, result: Result) -> List[str]:
+    s = result.statics or {}
+    lines = [f"static equilibrium by {s['method']}: {s['iterations']} iterations"
+             + (f", {s['load_steps']} load steps" if s["load_steps"] else ""),
+             f"  residuals: |Phi| {s['constraint_residual']:.2e}, force imbalance "
+             f"{s['force_residual']:.2e} (of loads {s['force_scale']:.3g})"]
+    squared = np.asarray(s["squared_frequencies"])
+    state = "stable" if s["stable"] else "neutral" if s["neutral"] else "UNSTABLE"
+    lowest = f", lowest omega^2 {squared[0]:.6g} 1/s^2" if len(squared) else ""
+    lines.append(f"  {state}{lowest}; least stiff: {', '.join(s['least_stiff']) or '-'}")
+    return lines + _final_columns(scene, result)
+
+
+def mode_table(found: Modes) -> dict:
+    """The modes as columns: mode, frequency (Hz, undamped), and the damped eigenvalues'
+    natural_frequency (Hz), damped_frequency (Hz) and damping_ratio, each list padded with NaN
+    to the longer one (an overdamped mode has two real eigenvalues)."""
+    columns = {"frequency": found.frequencies, "natural_frequency": found.natural_frequencies,
+               "damped_frequency": found.damped_frequencies,
+               "damping_ratio": found.damping_ratios}
+    n = max(len(v) for v in columns.values())
+    out = {"mode": np.arange(1, n + 1, dtype=float)}
+    for name, values in columns.items():
+        out[name] = np.concatenate([np.asarray(values, dtype=float),
+                                    np.full(n - len(values), np.nan)])
+    return out
+
+
+def _run_at_rest(args: argparse.Namespace, scene: Scene, kind: str, settings: dict) -> int:
+    """A static or modal analysis: one configuration, no time."""
+    start = time.monotonic()
+    outcome = scene.run(kind, **settings)
+    wall = time.monotonic() - start
+    found = outcome if isinstance(outcome, Modes) else None
+    result = found.equilibrium if found is not None else outcome
+    if args.out:
+        write_table(mode_table(found) if found is not None else scene.columns(result), args.out)
+    if found is not None and args.gif and len(found):
+        found.animate(0, args.gif)
+    if args.quiet:
+        return 0
+    target = f" -> {args.out}" if args.out else ""
+    print(f"odyn: {args.scene}{target}")
+    m = scene.model
+    print(f"{kind} analysis: {m.space} model, {m.num_velocities} coordinates, "
+          f"{m.num_equations} constraint equations, wall time {wall:.3f} s")
+    if found is None:
+        print("\n".join(static_lines(scene, result)))
+    else:
+        print("\n".join([f"  about the equilibrium, |Phi| {result.phi_norm[0]:.2e}"]
+                        + _final_columns(scene, result)))
+        shown = 12
+        table = mode_table(found)
+        count = len(found.frequencies)
+        print(f"  {count} mode{'' if count == 1 else 's'}; the lowest (undamped frequency, Hz; "
+              "the damped eigenvalues' natural frequency, Hz, and damping ratio):")
+        for i in range(min(len(table["mode"]), shown)):
+            print(f"  {i + 1:4d}  {table['frequency'][i]:12.6g}  "
+                  f"{table['natural_frequency'][i]:12.6g}  {table['damping_ratio'][i]:9.4g}")
+    return 0
+
+
 def _check(args: argparse.Namespace) -> int:
+    """The scene's validity, its model and analysis, and the model report (odyn.check): the
+    degrees of freedom, the redundant equations and what the assembly did."""
     scene = load(args.scene)
     m = scene.model
     print(f"odyn: {args.scene}: valid scene")
     print(f"  {m.space} model: {m.num_bodies} moving bodies ({', '.join(m.body_names[1:])}), "
-          f"{len(m.element_names)} elements, {m.num_equations} constraint equations, "
-          f"{m.num_velocities - m.num_equations} degrees of freedom if none is redundant")
+          f"{len(m.element_names)} elements")
     a = scene.analysis
-    print(f"  analysis: {describe_integrator(a)}, t_end {a['t_end']:g} s, output every "
-          f"{a['output_interval']:g} s")
+    kind = scene.analysis_type
+    if kind == "dynamic":
+        print(f"  analysis: {describe_integrator(a)}, t_end {a['t_end']:g} s, output every "
+              f"{a['output_interval']:g} s")
+    elif kind == "kinematic":
+        print(f"  analysis: kinematic, t_end {a['t_end']:g} s, output every "
+              f"{a['output_interval']:g} s")
+    else:
+        print(f"  analysis: {kind}, in {a.get('coordinates', 'absolute')} coordinates")
     print(f"  outputs: t, {', '.join(o['name'] for o in scene.outputs)}")
     if m.event_names:
         print(f"  events: {', '.join(m.event_names)}")
+    try:
+        report = check(m)
+    except _core.AssemblyError as e:
+        print(f"  the model does not assemble: {e}")
+        return 1
+    print("\n".join("  " + line for line in report.lines()))
     return 0
 
 

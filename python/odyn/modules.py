@@ -20,7 +20,8 @@ from ._schema import fail
 #: What a module of models must have (bind_models gives all of it).
 REQUIRED = ("Model", "PlanarModel", "element_types", "planar_element_types",
             "element_catalogue", "planar_element_catalogue", "joint_kinds",
-            "planar_joint_kinds", "assemble", "simulate", "statics", "modes")
+            "planar_joint_kinds", "assemble", "simulate", "statics", "modes", "kinematics",
+            "check")
 
 _registered: Dict[str, ModuleType] = {"odyn._core": _core}
 

@@ -135,7 +135,7 @@ class Result:
     event_times(name); ended_by: the terminal event that ended the run, or None.
     statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
     early); summary: the same as a dict, with the assembly report; statics: a static
-    equilibrium's summary (odyn.statics).
+    equilibrium's summary (odyn.statics); kinematics: a kinematic analysis's (odyn.kinematics).
     """
 
     def __init__(self, data: Dict[str, Any], interrupted: bool = False) -> None:
@@ -167,6 +167,8 @@ class Result:
         self.ended_by: Optional[str] = data.get("ended_by")
         #: A static equilibrium's summary (odyn.statics), None for other analyses.
         self.statics: Optional[Dict[str, Any]] = data.get("statics")
+        #: A kinematic analysis's summary (odyn.kinematics), None for other analyses.
+        self.kinematics: Optional[Dict[str, Any]] = data.get("kinematics")
 
     def __len__(self) -> int:
         return len(self.t)
@@ -459,11 +461,12 @@ def _check_order(order: Optional[int]) -> Optional[int]:
     return order
 
 
-def _warn(result: Result) -> None:
-    """Issues the result's warnings as Python warnings, where the user's code called."""
+def _warn(result: Result, depth: int = 0) -> None:
+    """Issues the result's warnings as Python warnings, where the user's code called (`depth`
+    frames above _warn's caller)."""
     for warning in result._warnings():
         warnings.warn(_WARNING_CLASSES.get(warning["kind"], UserWarning)(warning["text"]),
-                      stacklevel=3)
+                      stacklevel=3 + depth)
     equations = result.redundant_equations
     if equations:
         named = ", ".join(f"{e['joint']} (equation {e['equation']})" for e in equations)
@@ -471,7 +474,7 @@ def _warn(result: Result) -> None:
             f"{named}: constraint equations are redundant (they repeat what other joints "
             "already impose); the analysis uses the minimum-norm multipliers (large models: "
             "zero for these equations), so these reactions are one choice among many. Replace "
-            "a joint by one with fewer equations if you need them."), stacklevel=3)
+            "a joint by one with fewer equations if you need them."), stacklevel=3 + depth)
 
 
 #: The factorizations `linear_solver` may name (see `simulate`).
@@ -579,13 +582,18 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
     settings["events"] = model._event_table()
-    data = model.module.simulate(model._core, settings, progress)
+    return finished_run(model, model.module.simulate(model._core, settings, progress))
+
+
+def finished_run(model: BaseModel, data: Dict[str, Any]) -> Result:
+    """A run's Result from what the module recorded; raises the error that stopped it, with
+    the rows so far as its `result` (odyn.Interrupted for Ctrl-C)."""
     data["points"] = model._point_table()
     data["point_axes"] = model._point_axes()
     error = data.pop("error")
     if error is None:
         result = Result(data)
-        _warn(result)
+        _warn(result, depth=1)
         return result
     result = Result(data, interrupted=True)
     if isinstance(error, KeyboardInterrupt):

@@ -24,7 +24,10 @@
                    constraint_tolerance, max_iterations, projection_tolerance, order,
                    coordinates ("auto", "absolute" or "joint"); the integrator is a name of
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
-                   generalized-alpha when a step is given without rtol and atol)
+                   generalized-alpha when a step is given without rtol and atol;
+                   "type": "dynamic" (the default), "kinematic" (odyn.kinematics: t_end,
+                   output_interval, max_iterations), "static" or "modes" (odyn.statics,
+                   odyn.modes: max_iterations, coordinates "absolute" or "joint"))
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"},
                   {"name": "pin_vx", "point": "pin", "quantity": "velocity", "component": "x"},
@@ -45,14 +48,17 @@ from __future__ import annotations
 import csv
 import json
 import os
-from typing import Any, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple, Union
+from typing import (Any, Callable, Dict, List, Mapping, NoReturn, Optional, Sequence, Tuple,
+                    Union)
 
 import numpy as np
 
 from . import _schema, modules
 from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
 from .model import BaseModel, Model, new_model
+from .kinematics import kinematics
 from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
+from .statics import STATIC_COORDINATES, Modes, modes, statics
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
@@ -76,10 +82,19 @@ TOP_KEYS = ("odyn", "description", "space", "module", "bodies", "joints", "drive
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 # Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
 # or generalized-alpha (rho_inf 0.9) when a step is given without tolerances.
-ANALYSIS_OPTIONAL = ("integrator", "rho_inf", "step", "rtol", "atol", "max_step", "adaptive",
-                     "newton_rtol", "newton_atol",
-                     "constraint_tolerance", "max_iterations", "projection_tolerance", "order",
-                     "coordinates", "linear_solver")
+ANALYSIS_OPTIONAL = ("type", "integrator", "rho_inf", "step", "rtol", "atol", "max_step",
+                     "adaptive", "newton_rtol", "newton_atol", "constraint_tolerance",
+                     "max_iterations", "projection_tolerance", "order", "coordinates",
+                     "linear_solver")
+
+#: The analyses a scene may name ("type"), and the settings each takes beyond t_end and
+#: output_interval (which only the dynamic and kinematic analyses use).
+ANALYSES: Dict[str, Tuple[str, ...]] = {
+    "dynamic": ANALYSIS_OPTIONAL[1:],
+    "kinematic": ("max_iterations",),
+    "static": ("max_iterations", "coordinates"),
+    "modes": ("max_iterations", "coordinates"),
+}
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
@@ -114,7 +129,33 @@ class Scene:
     def simulate(self, **overrides: Any) -> Result:
         """Runs the scene's dynamic analysis; keyword arguments override its settings."""
         settings = {**self.analysis, **{k: v for k, v in overrides.items() if v is not None}}
+        settings.pop("type", None)
         return simulate(self.model, **settings)
+
+    @property
+    def analysis_type(self) -> str:
+        """The analysis the scene names: "dynamic" (the default), "kinematic", "static" or
+        "modes"."""
+        return self.analysis.get("type", "dynamic")
+
+    def run(self, analysis: Optional[str] = None,
+            progress: Optional[Callable[[float], None]] = None,
+            **overrides: Any) -> Union[Result, Modes]:
+        """Runs the scene's analysis, or `analysis` instead ("dynamic", "kinematic", "static"
+        or "modes", whose settings the scene's do not then need to fit: those of another
+        analysis are left out); keyword arguments override its settings. Returns a Result,
+        or Modes for "modes"."""
+        kind = check_choice(analysis or self.analysis_type, "analysis", list(ANALYSES))
+        settings = {**self.analysis, **{k: v for k, v in overrides.items() if v is not None}}
+        kept = {k: v for k, v in settings.items()
+                if k in ANALYSES[kind] or k in ANALYSIS_DEFAULTS}
+        if kind == "dynamic":
+            return simulate(self.model, progress=progress, **kept)
+        if kind == "kinematic":
+            return kinematics(self.model, progress=progress, **kept)
+        kept = {k: v for k, v in kept.items()
+                if k not in ANALYSIS_DEFAULTS and (k != "coordinates" or v != "auto")}
+        return (statics if kind == "static" else modes)(self.model, **kept)
 
     def columns(self, result: Result) -> Dict[str, np.ndarray]:
         """t and every output column of the scene, from a result."""
@@ -187,7 +228,16 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
             out[key] = check_number(value, w, minimum=0.0)
         else:
             out[key] = check_number(value, w, positive=True)
-    for key in ANALYSIS_OPTIONAL:
+    kind = check_choice(d.get("type", "dynamic"), f"{where}.type", list(ANALYSES))
+    if "type" in d:
+        out["type"] = kind
+    for key in ANALYSIS_OPTIONAL[1:]:
+        if key in d and key not in ANALYSES[kind]:
+            takes = ", ".join(["t_end", "output_interval"] * (kind == "kinematic")
+                              + list(ANALYSES[kind]))
+            fail(f"{where}.{key}", f"does not apply to a {kind} analysis, which takes {takes}; "
+                 "leave it out")
+    for key in ANALYSIS_OPTIONAL[1:]:
         if key in d:
             if key == "integrator":
                 out[key] = check_choice(d[key], f"{where}.{key}", list(integrators()))
@@ -207,7 +257,8 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                     fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
                 out[key] = d[key]
             elif key == "coordinates":
-                out[key] = check_choice(d[key], f"{where}.{key}", COORDINATES)
+                out[key] = check_choice(d[key], f"{where}.{key}",
+                                        COORDINATES if kind == "dynamic" else STATIC_COORDINATES)
             elif key == "linear_solver":
                 out[key] = check_choice(d[key], f"{where}.{key}", LINEAR_SOLVERS)
             elif key == "order":

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any, Dict, List, Optional
+from types import SimpleNamespace
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -65,10 +66,17 @@ class Modes:
     one of each conjugate pair): eigenvalues (complex, 1/s), natural_frequencies (|s|, Hz),
     damped_frequencies (Im s, Hz), damping_ratios (-Re s / |s|). The linearization: basis
     (n x k, the minimal coordinates' motions), mass, damping, stiffness (k x k) and
-    state_matrix (2k x 2k, for (z, z')). equilibrium: the pose they are about, a Result."""
+    state_matrix (2k x 2k, for (z, z')). equilibrium: the pose they are about, a Result.
+    body_shapes, body_motion(mode, body): the modes as the bodies' motions; animate(mode,
+    path): a GIF of one."""
 
-    def __init__(self, data: Dict[str, Any], equilibrium: Result) -> None:
+    def __init__(self, data: Dict[str, Any], equilibrium: Result,
+                 model: Optional[BaseModel] = None) -> None:
         self.equilibrium = equilibrium
+        self._model = model
+        #: (nv x k) each mode's motion as the bodies' velocities (per body: travel in global
+        #: axes, then turn in the body's axes, as Result.v), whatever the coordinates.
+        self.body_shapes: np.ndarray = np.asarray(data["body_shapes"])
         self.squared_frequencies: np.ndarray = np.asarray(data["squared_frequencies"])
         self.frequencies: np.ndarray = np.asarray(data["frequencies"])
         self.shapes: np.ndarray = np.asarray(data["shapes"])
@@ -99,6 +107,74 @@ class Modes:
                  f"{', '.join(self.coordinates)}")
         return float(column[self.coordinates.index(coordinate)])
 
+    def body_motion(self, mode: int, body: str) -> Tuple[np.ndarray, Any]:
+        """How mode `mode` moves a body: (travel of its centre, global axes; turn, about its
+        own axes in space, a number in the plane), in the mode's mass-normalized units."""
+        self.shape(mode)  # checks the number
+        names = self.equilibrium.body_names
+        if body not in names:
+            fail("body", f"no moving body '{body}'; bodies: {', '.join(names)}")
+        planar = self.equilibrium.space == "planar"
+        width, dim = (3, 2) if planar else (6, 3)
+        column = self.body_shapes[width * names.index(body):width * (names.index(body) + 1),
+                                  mode]
+        return column[:dim], (float(column[2]) if planar else column[dim:])
+
+    def animate(self, mode: int, path: str, *, amplitude: Optional[float] = None,
+                frames: int = 30, fps: int = 15) -> None:
+        """A GIF of mode `mode` (0 is the lowest): one period of the bodies swinging along it
+        about the equilibrium, drawn as odyn.plot.animate draws a run. amplitude: the largest
+        travel of a body's centre or turn times the model's size, m (default: a tenth of the
+        model's size). The motion is the linearized one: large amplitudes stretch the links."""
+        from .plot import animate
+        self.shape(mode)
+        if self._model is None:
+            fail("animate", "these modes carry no model to draw")
+        motion = _ModeMotion(self, mode, amplitude, frames)
+        animate(motion, self._model, path, frames=frames, fps=fps,
+                title=f"mode {mode + 1}, {self.frequencies[mode]:.4g} Hz")
+
+
+class _ModeMotion:
+    """One period of a mode about the equilibrium, as a Result that odyn.plot.animate draws."""
+
+    def __init__(self, found: Modes, mode: int, amplitude: Optional[float], frames: int) -> None:
+        rest = found.equilibrium
+        self.space, self.body_names = rest.space, rest.body_names
+        period = 1.0 / found.frequencies[mode] if found.frequencies[mode] > 0 else 1.0
+        self.t = np.linspace(0.0, period, frames, endpoint=False)
+        centres = np.array([rest.body(b).position[0] for b in self.body_names])
+        size = max(1e-3, float(np.max(np.abs(centres - centres.mean(axis=0)))) * 2)
+        motions = [found.body_motion(mode, b) for b in self.body_names]
+        largest = max(max(float(np.max(np.abs(t))), float(np.max(np.abs(r)) * size))
+                      for t, r in motions)
+        scale = (amplitude if amplitude is not None else 0.1 * size) / max(largest, 1e-300)
+        swing = scale * np.sin(2 * np.pi * self.t / period)
+        self._bodies: Dict[str, SimpleNamespace] = {}
+        for b, (travel, turn) in zip(self.body_names, motions):
+            at = rest.body(b)
+            position = at.position[0] + np.outer(swing, travel)
+            if self.space == "planar":
+                self._bodies[b] = SimpleNamespace(position=position,
+                                                  angle=at.angle[0] + swing * turn)
+            else:
+                self._bodies[b] = SimpleNamespace(
+                    position=position,
+                    orientation=np.array([_turned(at.orientation[0], s * turn) for s in swing]))
+
+    def body(self, name: str) -> SimpleNamespace:
+        return self._bodies[name]
+
+
+def _turned(quaternion: np.ndarray, turn: np.ndarray) -> np.ndarray:
+    """The unit quaternion (w, x, y, z) turned further by the rotation vector `turn` (body
+    axes)."""
+    angle = float(np.linalg.norm(turn))
+    axis = turn / angle if angle > 0 else np.zeros(3)
+    w2, v2 = np.cos(angle / 2), np.sin(angle / 2) * axis
+    w1, v1 = quaternion[0], np.asarray(quaternion[1:])
+    return np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+
 
 def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: bool = True,
           tolerance: float = 1e-12, max_iterations: int = 60, load_stepping: bool = True,
@@ -106,12 +182,12 @@ def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: 
     """The natural modes about the static equilibrium near the model's pose (found as
     `statics` finds it, with the same settings), or, with find_equilibrium=False, about the
     pose as it is (its joints closed), which must then balance its loads (odyn.SolverError
-    names the coordinate that it does not). The stiffness holds the forces' and the constraints' geometric
-    stiffness, from differences of the equations of motion; dense, for models of up to a few
-    hundred coordinates. See `Modes`."""
+    names the coordinate that it does not). The stiffness holds the forces' and the
+    constraints' geometric stiffness, from differences of the equations of motion; dense, for
+    models of up to a few hundred coordinates. See `Modes`."""
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
                                 max_load_steps, relaxation)
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")
     data = model.module.modes(model._core, settings)
     found = data.pop("modes")
-    return Modes(found, _result(model, data))
+    return Modes(found, _result(model, data), model)

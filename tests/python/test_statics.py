@@ -70,10 +70,26 @@ def test_a_free_motion_under_load_is_refused_by_name():
         odyn.statics(m, max_iterations=0)
 
 
+M1, L1, M2, L2 = 1.0, 1.0, 0.6, 0.8  # the double pendulum's bars: masses, lengths
+
+
+def double_pendulum():
+    """Two uniform bars hanging straight down from a hinge at the origin."""
+    d1, d2 = L1 / 2, L2 / 2
+    m = odyn.PlanarModel()
+    m.add_body(name="upper", mass=M1, inertia=M1 * L1 ** 2 / 12, position=[0, -d1])
+    m.add_body(name="lower", mass=M2, inertia=M2 * L2 ** 2 / 12, position=[0, -L1 - d2])
+    m.add_revolute(name="shoulder", body_a="ground", body_b="upper", on_b=odyn.frame([0, d1]))
+    m.add_revolute(name="elbow", body_a="upper", on_a=odyn.frame([0, -d1]), body_b="lower",
+                   on_b=odyn.frame([0, d2]))
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    return m
+
+
 @pytest.mark.parametrize("coordinates", ["absolute", "joint"])
 def test_double_pendulum_frequencies(coordinates):
     """Two uniform bars hanging down: det(K - w^2 M) = 0 in the bars' angles."""
-    m1, l1, m2, l2 = 1.0, 1.0, 0.6, 0.8
+    m1, l1, m2, l2 = M1, L1, M2, L2
     d1, d2, i1, i2 = l1 / 2, l2 / 2, m1 * l1 ** 2 / 12, m2 * l2 ** 2 / 12
     mass = np.array([[i1 + m1 * d1 ** 2 + m2 * l1 ** 2, m2 * l1 * d2],
                      [m2 * l1 * d2, i2 + m2 * d2 ** 2]])
@@ -81,14 +97,7 @@ def test_double_pendulum_frequencies(coordinates):
     omega2 = np.sort(np.linalg.eigvals(np.linalg.solve(mass, stiffness)).real)
     expected = np.sqrt(omega2) / (2 * math.pi)
 
-    m = odyn.PlanarModel()
-    m.add_body(name="upper", mass=m1, inertia=i1, position=[0, -d1])
-    m.add_body(name="lower", mass=m2, inertia=i2, position=[0, -l1 - d2])
-    m.add_revolute(name="shoulder", body_a="ground", body_b="upper", on_b=odyn.frame([0, d1]))
-    m.add_revolute(name="elbow", body_a="upper", on_a=odyn.frame([0, -d1]), body_b="lower",
-                   on_b=odyn.frame([0, d2]))
-    m.add_gravity(name="gravity", acceleration=[0, -G])
-    modes = odyn.modes(m, coordinates=coordinates)
+    modes = odyn.modes(double_pendulum(), coordinates=coordinates)
     assert len(modes) == 2
     np.testing.assert_allclose(modes.frequencies, expected, rtol=1e-10)
     np.testing.assert_allclose(modes.natural_frequencies, expected, rtol=1e-10)
@@ -123,3 +132,23 @@ def test_damped_oscillator():
     assert modes.damping_ratios[0] == pytest.approx(zeta, rel=1e-10)
     assert modes.eigenvalues[0].real == pytest.approx(-zeta * wn, rel=1e-10)
     assert modes.coordinates == ["slide.travel"]
+
+
+def test_a_mode_moves_the_bodies_as_its_joint_coordinates_say(tmp_path):
+    """The double pendulum's modes in joint coordinates, mapped to the bars' motions, are those
+    of absolute coordinates (up to sign); the upper bar's centre travels d1 per unit of its
+    angle; and the lowest mode animates."""
+    absolute = odyn.modes(double_pendulum(), coordinates="absolute")
+    joint = odyn.modes(double_pendulum(), coordinates="joint")
+    for k in range(2):
+        a, b = absolute.body_shapes[:, k], joint.body_shapes[:, k]
+        assert min(np.linalg.norm(a - b), np.linalg.norm(a + b)) < 1e-8 * np.linalg.norm(a)
+        travel, turn = joint.body_motion(k, "upper")
+        assert turn == pytest.approx(joint.shape(k, "shoulder.angle"), abs=1e-12)
+        np.testing.assert_allclose(travel, [0.5 * turn, 0.0], atol=1e-12)  # hanging: along x
+    np.testing.assert_array_equal(absolute.body_shapes, absolute.shapes)
+    path = tmp_path / "mode.gif"
+    joint.animate(0, str(path), frames=6)
+    assert path.stat().st_size > 0
+    with pytest.raises(odyn.SceneError, match="no moving body 'elbow'"):
+        joint.body_motion(0, "elbow")

@@ -59,6 +59,10 @@ struct Modes {
   Eigen::VectorXd damped_frequencies;           // Im(s) / 2 pi, Hz
   Eigen::VectorXd damping_ratios;               // -Re(s) / |s|
   std::vector<VelocityCoordinate> coordinates;  // what each row of `shapes` is
+  /// (nv x k, the model's velocities) each undamped mode's motion as the bodies' velocities,
+  /// as Workspace::v holds them (per body: travel in global axes, turn in the body's), whatever
+  /// coordinates the analysis ran in: what a mode moves.
+  Eigen::MatrixXd body_shapes;
   Linearization linearization;
 };
 
@@ -152,6 +156,28 @@ Modes modes_here(Coordinates& c, double t, double length) {
   return out;
 }
 
+/// Each column of `shapes` (motions in the coordinates' velocities) as the bodies' velocities,
+/// read from the frames the coordinates update; leaves the coordinates at rest.
+template <class Coordinates, class Model>
+Eigen::MatrixXd body_motions(Coordinates& c, const Model& model, const Workspace<Model>& ws,
+                             const Eigen::MatrixXd& shapes) {
+  using Space = typename Model::Space;
+  Eigen::MatrixXd out(model.num_velocities(), shapes.cols());
+  for (Eigen::Index k = 0; k < shapes.cols(); ++k) {
+    c.velocities() = shapes.col(k);
+    c.update_frames();
+    for (int b = 1; b <= model.num_bodies(); ++b) {
+      const auto& frame = ws.frames[static_cast<std::size_t>(b)];
+      const Eigen::Index row = Space::nv * (b - 1);
+      out.col(k).template segment<Space::dim>(row) = frame.linear_velocity;
+      out.col(k).template segment<Space::nw>(row + Space::dim) = frame.angular_velocity;
+    }
+  }
+  c.velocities().setZero();
+  c.update_frames();
+  return out;
+}
+
 }  // namespace detail
 
 struct ModeSettings {
@@ -189,10 +215,14 @@ Modes natural_modes(const Model& model, Workspace<Model>& ws, const ModeSettings
   const double length = detail::model_size(model, ws);
   if (s.coordinates == "joint") {
     JointCoordinates<Model> c(model, ws);
-    return detail::modes_here(c, ws.t, length);
+    Modes out = detail::modes_here(c, ws.t, length);
+    out.body_shapes = detail::body_motions(c, model, ws, out.shapes);
+    return out;
   }
   AbsoluteCoordinates<Model> c(model, ws, LinearSolver::dense);
-  return detail::modes_here(c, ws.t, length);
+  Modes out = detail::modes_here(c, ws.t, length);
+  out.body_shapes = out.shapes;
+  return out;
 }
 
 }  // namespace odyn

@@ -1,10 +1,10 @@
 #pragma once
-// Assembly, dynamic, static and modal analysis from Python, for any model type of a module
-// (odyn._core compiles its two models' in python/src/analyses.cpp and analyses_planar.cpp). A run
-// releases the GIL; at every output time it records the state, the energies, the residuals, every
-// constraint's reactions, every stateful force's state and every element's outputs
-// (core/outputs.hpp), then briefly takes the GIL to let Python handle signals (Ctrl-C) and report
-// progress. A run that stops early keeps what it recorded.
+// Assembly, dynamic, kinematic, static and modal analysis and the model report from Python, for
+// any model type of a module (odyn._core compiles its two models' in python/src/analyses.cpp and
+// analyses_planar.cpp). A run releases the GIL; at every output time it records the state, the
+// energies, the residuals, every constraint's reactions, every stateful force's state and every
+// element's outputs (core/outputs.hpp), then briefly takes the GIL to let Python handle signals
+// (Ctrl-C) and report progress. A run that stops early keeps what it recorded.
 
 #include <Python.h>
 #include <pybind11/complex.h>
@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include <odyn/analysis/kinematics.hpp>
 #include <odyn/analysis/modes.hpp>
 #include <odyn/analysis/statics.hpp>
 #include <odyn/python/errors.hpp>
@@ -435,6 +436,25 @@ py::dict assemble(Box& box, const py::dict& settings) {
   return out;
 }
 
+/// The callback of a run's output times (the GIL released): records the state, then briefly
+/// takes the GIL to let Python handle signals (Ctrl-C raises there) and report progress(t) about
+/// every `interval` seconds of wall time.
+template <class M>
+auto reporting(Recorder<M>& recorder, const py::object& progress, double interval) {
+  using Clock = std::chrono::steady_clock;
+  return [&recorder, &progress, interval,
+          last_report = Clock::now()](const odyn::Workspace<M>& state) mutable {
+    recorder.record(state);
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!progress.is_none() &&
+        std::chrono::duration<double>(Clock::now() - last_report).count() >= interval) {
+      progress(state.t);
+      last_report = Clock::now();
+    }
+  };
+}
+
 template <class Box>
 py::dict simulate(Box& box, const py::dict& settings, py::object progress,
                   double progress_interval) {
@@ -449,21 +469,9 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
   {
     py::gil_scoped_release release;
     box.monitor->start();
-    using Clock = std::chrono::steady_clock;
-    auto last_report = Clock::now();
     try {
-      const auto record = [&](const odyn::Workspace<M>& state) {
-        recorder.record(state);
-        py::gil_scoped_acquire gil;
-        if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C, say
-        if (!progress.is_none() &&
-            std::chrono::duration<double>(Clock::now() - last_report).count() >=
-                progress_interval) {
-          progress(state.t);
-          last_report = Clock::now();
-        }
-      };
-      summary = odyn::simulate(box.model, ws, s, record, &box.assembled, watches);
+      summary = odyn::simulate(box.model, ws, s, reporting(recorder, progress, progress_interval),
+                               &box.assembled, watches);
     } catch (...) {
       error = std::current_exception();
     }
@@ -542,6 +550,7 @@ py::dict modes(Box& box, const py::dict& settings) {
   std::vector<std::string> names;
   for (const VelocityCoordinate& c : found.coordinates) names.push_back(c.text());
   m["coordinates"] = names;
+  m["body_shapes"] = found.body_shapes;
   const Linearization& l = found.linearization;
   m["basis"] = l.basis;
   m["mass"] = l.mass;
@@ -552,8 +561,80 @@ py::dict modes(Box& box, const py::dict& settings) {
   return out;
 }
 
-/// Registers assemble, simulate, statics and modes for one model type (pybind11 overloads by
-/// the model).
+inline KinematicSettings kinematic_settings(const py::dict& d) {
+  KinematicSettings s;
+  s.tolerance = get(d, "tolerance", s.tolerance);
+  s.max_iterations = get(d, "max_iterations", s.max_iterations);
+  s.max_halvings = get(d, "max_halvings", s.max_halvings);
+  return s;
+}
+
+/// A kinematic analysis (analysis/kinematics.hpp) from t = 0 to t_end, recorded as a run is:
+/// the rows, a summary (None if it stopped early) and the exception that stopped it.
+template <class Box>
+py::dict kinematics(Box& box, const py::dict& settings, py::object progress,
+                    double progress_interval) {
+  using M = typename Box::ModelType;
+  const KinematicSettings s = kinematic_settings(settings);
+  const double t_end = get(settings, "t_end", 1.0);
+  const double interval = get(settings, "output_interval", 1e-3);
+  Running<Box> running(box);
+  odyn::Workspace<M> ws(box.model);
+  Recorder<M> recorder(box.model);
+  std::exception_ptr error;
+  double wall_seconds = 0.0;
+  {
+    py::gil_scoped_release release;
+    box.monitor->start();
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      odyn::kinematic_analysis(box.model, ws, t_end, interval,
+                               reporting(recorder, progress, progress_interval), s);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  py::dict out = recorder.to_python();
+  py::dict summary;
+  summary["outputs"] = recorder.rows();
+  summary["wall_seconds"] = wall_seconds;
+  out["kinematics"] = error ? py::object(py::none()) : py::object(summary);
+  out["error"] = error ? python_exception(error) : py::object(py::none());
+  return out;
+}
+
+/// The model report at the assembled configuration: assembly's report and the mobility that
+/// the constraint Jacobian's rank gives (analysis/kinematics.hpp), as one output row.
+template <class Box>
+py::dict check(Box& box, const py::dict& settings) {
+  struct Found {
+    AssemblyReport assembly;
+    Mobility mobility;
+    Eigen::VectorXd given;  // the velocities before assembly
+  };
+  const AssemblySettings s = assembly_settings(settings);
+  auto [out, found] = recorded(box, [&](auto& ws) {
+    Found f;
+    f.given = ws.v;
+    f.assembly = odyn::assemble(box.model, ws, s);
+    f.mobility = odyn::mobility(box.model, ws);
+    return f;
+  });
+  out["assembly"] = assembly_report(found.assembly);
+  out["given_velocities"] = found.given;
+  py::dict m;
+  m["velocities"] = found.mobility.velocities;
+  m["equations"] = found.mobility.equations;
+  m["rank"] = found.mobility.rank;
+  m["redundant_equations"] = redundant_list(found.mobility.repeated);
+  m["drivers"] = found.mobility.drivers;
+  out["mobility"] = m;
+  return out;
+}
+
+/// Registers assemble, simulate, kinematics, check, statics and modes for one model type (pybind11
+/// overloads by the model).
 template <class Box>
 void bind(py::module_& m) {
   m.def("statics", &statics<Box>, py::arg("model"), py::arg("settings"),
@@ -561,6 +642,13 @@ void bind(py::module_& m) {
   m.def("modes", &modes<Box>, py::arg("model"), py::arg("settings"),
         "Finds the natural modes about the static equilibrium; returns the equilibrium as one "
         "output row, with the modes.");
+  m.def("kinematics", &kinematics<Box>, py::arg("model"), py::arg("settings"),
+        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
+        "Runs a kinematic analysis; returns the recorded outputs, the summary (None if it "
+        "stopped early) and the exception that stopped it (None if it finished).");
+  m.def("check", &check<Box>, py::arg("model"), py::arg("settings"),
+        "Assembles the model and reports its mobility; returns the assembled state as one "
+        "output row, with the assembly's report and the mobility.");
   m.def("assemble", &assemble<Box>, py::arg("model"), py::arg("settings"),
         "Assembles the model; returns its consistent initial state as one output row.");
   m.def("simulate", &simulate<Box>, py::arg("model"), py::arg("settings"),
