@@ -99,8 +99,8 @@ class ModelReport:
         dof = self.degrees_of_freedom
         out = [f"{self.space} model: {self.bodies} moving bodies, {self.velocities} velocity "
                f"coordinates, {self.equations} constraint equations"
-               + (f" ({len(self.drivers)} from the drivers {', '.join(self.drivers)})"
-                  if self.drivers else ""),
+               + (f" ({len(self.drivers)} from its driver{'s' if len(self.drivers) > 1 else ''}"
+                  f": {', '.join(self.drivers)})" if self.drivers else ""),
                f"degrees of freedom: {dof} (Gruebler's count {self.gruebler}; the constraint "
                f"Jacobian's rank {self.rank})"]
         if self.redundant_equations:
