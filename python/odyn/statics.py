@@ -70,8 +70,7 @@ class Modes:
     body_shapes, body_motion(mode, body): the modes as the bodies' motions; animate(mode,
     path): a GIF of one."""
 
-    def __init__(self, data: Dict[str, Any], equilibrium: Result,
-                 model: Optional[BaseModel] = None) -> None:
+    def __init__(self, data: Dict[str, Any], equilibrium: Result, model: BaseModel) -> None:
         self.equilibrium = equilibrium
         self._model = model
         #: (nv x k) each mode's motion as the bodies' velocities (per body: travel in global
@@ -128,8 +127,6 @@ class Modes:
         model's size). The motion is the linearized one: large amplitudes stretch the links."""
         from .plot import animate
         self.shape(mode)
-        if self._model is None:
-            fail("animate", "these modes carry no model to draw")
         motion = _ModeMotion(self, mode, amplitude, frames)
         animate(motion, self._model, path, frames=frames, fps=fps,
                 title=f"mode {mode + 1}, {self.frequencies[mode]:.4g} Hz")

@@ -162,7 +162,7 @@ def spatial_four_bar():
 
 def test_check_finds_the_redundant_equations_of_a_spatial_four_bar():
     with pytest.warns(odyn.RedundantConstraintsWarning):
-        odyn.assemble(spatial_four_bar())  # the run's warning, for comparison
+        odyn.assemble(spatial_four_bar())  # a run warns of them too
     report = odyn.check(spatial_four_bar())
     assert (report.velocities, report.equations) == (18, 20)
     assert report.gruebler == -2 and report.degrees_of_freedom == 1 and report.rank == 17
