@@ -11,6 +11,7 @@
 #include <odyn/analysis/modes.hpp>
 #include <odyn/odyn.hpp>
 
+#include "hinge_chain.hpp"
 #include "spring_plate.hpp"
 
 namespace test_modes {
@@ -190,6 +191,92 @@ TEST_CASE("A spring-hung plate's three frequencies are those of its small free v
         2.0 * (crossings.back() - crossings.front()) / double(crossings.size() - 1);
     CHECK(1.0 / measured == Approx(modes.frequencies[mode]).epsilon(1e-8));
   }
+}
+
+TEST_CASE("The sparse path gives a long spring chain's lowest frequencies", "[modes]") {
+  // 300 blocks: 900 velocity coordinates, over the automatic method's threshold, so statics and
+  // modes both run sparse; the lowest 20 of the analytic spectrum, as the dense test's.
+  const int n = 300;
+  const double m = 2.0, k = 100.0;
+  const PlanarModel model = spring_chain(n, m, k, 0.0);
+  odyn::Workspace<PlanarModel> ws(model);
+  const odyn::Modes modes = odyn::natural_modes(model, ws, {.count = 20});
+  REQUIRE(modes.frequencies.size() == 20);
+  for (int j = 1; j <= 20; ++j) {
+    const double w = 2.0 * std::sqrt(k / m) * std::sin(j * std::numbers::pi / (2.0 * (n + 1)));
+    CHECK(modes.frequencies[j - 1] == Approx(w / two_pi).epsilon(1e-10));
+    // Nothing damps: the damped modes are the undamped ones.
+    CHECK(modes.natural_frequencies[j - 1] == Approx(w / two_pi).epsilon(1e-10));
+    CHECK(modes.damping_ratios[j - 1] == 0.0);
+  }
+  // Shapes are mass-normalized and move each block along its slide only.
+  const Eigen::VectorXd shape = modes.shapes.col(0);
+  CHECK(m * shape(Eigen::seq(0, Eigen::last, 3)).squaredNorm() ==
+        Approx(1.0 - 0.01 * shape(Eigen::seq(2, Eigen::last, 3)).squaredNorm()).epsilon(1e-12));
+  CHECK(shape(Eigen::seq(1, Eigen::last, 3)).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK(modes.linearization.mass.size() == 0);  // the sparse path forms no reduced matrices
+
+  // With dampers the damped modes are left to the dense method.
+  const PlanarModel damped = spring_chain(n, m, k, 0.5);
+  odyn::Workspace<PlanarModel> damped_ws(damped);
+  const odyn::Modes undamped_only = odyn::natural_modes(damped, damped_ws, {.count = 5});
+  CHECK(undamped_only.frequencies.size() == 5);
+  CHECK(undamped_only.eigenvalues.size() == 0);
+}
+
+TEST_CASE("Sparse statics and modes of a hanging chain agree with the dense joint coordinates",
+          "[modes]") {
+  // 40 hinged links turned by 0.3 rad: statics bring the chain down (sparse Newton in absolute
+  // coordinates, against Newton on a dense tangent in joint coordinates), then the lowest 8
+  // modes (shift-invert Lanczos, against the dense generalized eigenproblem).
+  const hinge_chain::Model model = hinge_chain::build(40, 0.3);
+  odyn::Workspace<hinge_chain::Model> sparse_ws(model), joint_ws(model);
+  const odyn::Modes sparse =
+      odyn::natural_modes(model, sparse_ws, {.count = 8, .method = "sparse"});
+  const odyn::Modes joint =
+      odyn::natural_modes(model, joint_ws, {.coordinates = "joint", .count = 8});
+  REQUIRE(sparse.frequencies.size() == 8);
+  REQUIRE(sparse.natural_frequencies.size() == 8);
+  REQUIRE(joint.frequencies.size() == 8);
+  for (int b = 1; b <= model.num_bodies(); ++b)
+    CHECK((sparse_ws.frames[b].position - joint_ws.frames[b].position).norm() < 1e-10);
+  for (int k = 0; k < 8; ++k) {
+    CAPTURE(k);
+    CHECK(sparse.frequencies[k] == Approx(joint.frequencies[k]).epsilon(1e-9));
+    // Nothing damps (C is rounding, 1e-28): the damped modes are the undamped ones.
+    CHECK(sparse.natural_frequencies[k] == Approx(joint.frequencies[k]).epsilon(1e-9));
+    const Eigen::VectorXd a = sparse.body_shapes.col(k), b = joint.body_shapes.col(k);
+    CHECK(std::min((a - b).norm(), (a + b).norm()) < 1e-7 * a.norm());
+  }
+  // Statics alone, sparse against dense in the same coordinates: the same pose, the same
+  // multipliers (the hinges repeat no equation), the same lowest squared frequency.
+  odyn::Workspace<hinge_chain::Model> a_ws(model), b_ws(model);
+  const odyn::StaticSummary a = odyn::static_equilibrium(model, a_ws, {.method = "sparse"});
+  const odyn::StaticSummary b = odyn::static_equilibrium(model, b_ws, {.method = "dense"});
+  CHECK((a_ws.q - b_ws.q).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((a_ws.lambda - b_ws.lambda).cwiseAbs().maxCoeff() <
+        1e-8 * b_ws.lambda.cwiseAbs().maxCoeff());
+  CHECK(a.stability.stable);
+  CHECK(a.stability.squared_frequencies[0] ==
+        Approx(b.stability.squared_frequencies[0]).epsilon(1e-9));
+  CHECK(a.force_residual < 1e-12);
+}
+
+TEST_CASE("A method or count that does not apply is refused by name", "[modes]") {
+  const PlanarModel model = spring_chain(2, 1.0, 10.0, 0.0);
+  odyn::Workspace<PlanarModel> ws(model);
+  CHECK_THROWS_WITH(odyn::natural_modes(model, ws, {.coordinates = "joint", .method = "sparse"}),
+                    Catch::Contains("sparse method runs in absolute coordinates"));
+  CHECK_THROWS_WITH(odyn::natural_modes(model, ws, {.method = "fast"}),
+                    Catch::Contains("method 'fast' unknown"));
+  CHECK_THROWS_WITH(odyn::natural_modes(model, ws, {.count = -1}),
+                    Catch::Contains("count must be 0 (all) or positive"));
+  CHECK_THROWS_WITH(odyn::static_equilibrium(model, ws, {.method = "fast"}),
+                    Catch::Contains("method 'fast' unknown"));
+  // Dense with a count: the lowest of all modes.
+  const odyn::Modes two = odyn::natural_modes(model, ws, {.count = 1, .method = "dense"});
+  CHECK(two.frequencies.size() == 1);
+  CHECK(two.eigenvalues.size() == 1);
 }
 
 }  // namespace test_modes

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include <odyn/analysis/quasi_statics.hpp>
 #include <odyn/analysis/statics.hpp>
 #include <odyn/odyn.hpp>
 
@@ -254,6 +255,65 @@ TEST_CASE("A spring-hung plate's equilibrium is its potential energy's minimum",
       total += blocks.force[0].head<3>();
     }
     CHECK(total.norm() < 1e-10);
+  }
+}
+
+TEST_CASE("A slowly turned slider-crank needs the torque that the virtual work gives",
+          "[statics]") {
+  // The crank (r, mass mc) turned by a motor against a spring on the slider (to a wall at x_w)
+  // and the bars' weight: at rest at every angle, tau = dV/dtheta with
+  //   V = k (x_w - x - L0)^2 / 2 + g (mc + mr) (r / 2) sin(theta),
+  //   x = r cos(theta) + sqrt(l^2 - r^2 sin^2(theta)).
+  using Model =
+      pl::Model<pl::Revolute, pl::Translational, pl::Tsda, pl::Gravity, pl::RevoluteDriver>;
+  const double r = 0.2, l = 0.5, mc = 1.0, mr = 0.5, k = 200.0, wall = 1.0, free = 0.4, g = 9.81;
+  Model m;
+  const BodyId crank =
+      m.add_body({.name = "crank", .mass = mc, .inertia = 0.01, .position = {r / 2, 0.0}});
+  const BodyId rod =
+      m.add_body({.name = "rod", .mass = mr, .inertia = 0.02, .position = {r + l / 2, 0.0}});
+  const BodyId slider =
+      m.add_body({.name = "slider", .mass = 2.0, .inertia = 0.01, .position = {r + l, 0.0}});
+  const pl::Revolute pivot("pivot", odyn::ground, {{0.0, 0.0}}, crank, {{-r / 2, 0.0}});
+  m.add(pivot);
+  m.add(pl::Revolute("pin", crank, {{r / 2, 0.0}}, rod, {{-l / 2, 0.0}}));
+  m.add(pl::Revolute("wrist", rod, {{l / 2, 0.0}}, slider, {{0.0, 0.0}}));
+  m.add(pl::Translational("slide", odyn::ground, {{0.0, 0.0}, {1.0, 0.0}}, slider,
+                          {{0.0, 0.0}, {1.0, 0.0}}));
+  m.add(pl::Tsda("spring", slider, {0.0, 0.0}, odyn::ground, {wall, 0.0},
+                 {.stiffness = k, .damping = 0.0, .free_length = free}));
+  m.add(pl::Gravity("gravity", {0.0, -g}));
+  const auto motor =
+      m.add(pl::RevoluteDriver("motor", pivot, odyn::Motion::constant_velocity(1.0)));
+  const auto torque = [&](double theta) {
+    const double root = std::sqrt(l * l - r * r * std::sin(theta) * std::sin(theta));
+    const double x = r * std::cos(theta) + root;
+    const double slope = -r * std::sin(theta) - r * r * std::sin(theta) * std::cos(theta) / root;
+    return -k * (wall - x - free) * slope + g * (mc + mr) * (r / 2) * std::cos(theta);
+  };
+  for (const char* coordinates : {"absolute", "joint"}) {
+    CAPTURE(coordinates);
+    odyn::Workspace<Model> ws(m);
+    odyn::QuasiStaticSettings s;
+    s.statics.coordinates = coordinates;
+    double worst = 0.0, largest = 0.0;
+    int rows = 0;
+    odyn::quasi_static_analysis(
+        m, ws, 6.0, 0.1,
+        [&](const odyn::Workspace<Model>& at, const odyn::StaticSummary& summary) {
+          ++rows;
+          CHECK(summary.force_residual < 1e-12);
+          const double angle = at.frames[crank.index].angle;  // the motor's: t
+          CHECK(std::abs(std::remainder(angle - at.t, 2 * std::numbers::pi)) < 1e-10);
+          const double expected = torque(at.t);
+          worst = std::max(
+              worst, std::abs(odyn::reaction(m, at, motor, odyn::Side::b).torque[0] - expected));
+          largest = std::max(largest, std::abs(expected));
+        },
+        s);
+    CHECK(rows == 61);
+    INFO("torque error " << worst << " of " << largest << " N m");
+    CHECK(worst < 1e-9 * largest);
   }
 }
 

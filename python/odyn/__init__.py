@@ -20,8 +20,8 @@ elements compiled in.
 
 odyn.integrators(): the integrators by name, with what they are.
 Other analyses: odyn.kinematics (a fully driven mechanism, with the drivers' efforts),
-odyn.statics, odyn.modes; odyn.check(model) reports its degrees of freedom and redundant
-equations.
+odyn.statics, odyn.quasi_statics (equilibria along a driver's motion), odyn.modes;
+odyn.check(model) reports its degrees of freedom and redundant equations.
 
 Scenes: odyn.load(path) -> Scene (model + analysis settings + outputs), odyn.save(scene, path).
 Command line: odyn run SCENE (python -m odyn run SCENE).
@@ -41,7 +41,7 @@ from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBo
                       ToleranceWarning, assemble, integrators, simulate)
 from .scene import Scene, load, loads, save
 from .kinematics import ModelReport, check, kinematics
-from .statics import Modes, modes, statics
+from .statics import Modes, modes, quasi_statics, statics
 
 #: Every element type that Model.add accepts (and scenes, except user_force and
 #: user_constraint).
@@ -59,5 +59,6 @@ __all__ = [
     "SceneError", "SolverError", "Statistics", "ToleranceWarning", "assemble", "check",
     "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
     "hunt_crossley_dissipation", "integrators", "kinematics", "load", "loads", "motion_function",
-    "modes", "planar_element_types", "polynomial", "save", "simulate", "statics",
+    "modes", "planar_element_types", "polynomial", "quasi_statics", "save", "simulate",
+    "statics",
 ]

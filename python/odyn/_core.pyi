@@ -54,6 +54,12 @@ def kinematics(model: Union[Model, PlanarModel], settings: Dict[str, Any],
     """A kinematic analysis: the recorded arrays, "kinematics" (its summary, None if it stopped
     early) and "error" (the exception that stopped it, or None)."""
 
+def quasi_statics(model: Union[Model, PlanarModel], settings: Dict[str, Any],
+                  progress: Optional[Callable[[float], None]] = None,
+                  progress_interval: float = 0.2) -> Dict[str, Any]:
+    """A quasi-static analysis: the recorded arrays, "statics" (each row's summary) and
+    "error" (the exception that stopped it, or None)."""
+
 def check(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
     """Assembles and reports: the recorded arrays for one output row, "assembly" (a report),
     "given_velocities" (before assembly) and "mobility" (velocities, equations, rank,

@@ -165,8 +165,9 @@ class Result:
             name: np.asarray(r, dtype=float) for name, r in data.get("point_axes", {}).items()}
         self.events: List[Event] = [Event(**e) for e in data.get("events", [])]
         self.ended_by: Optional[str] = data.get("ended_by")
-        #: A static equilibrium's summary (odyn.statics), None for other analyses.
-        self.statics: Optional[Dict[str, Any]] = data.get("statics")
+        #: A static equilibrium's summary (odyn.statics), a list of one per row
+        #: (odyn.quasi_statics), None for other analyses.
+        self.statics: Optional[Any] = data.get("statics")
         #: A kinematic analysis's summary (odyn.kinematics), None for other analyses.
         self.kinematics: Optional[Dict[str, Any]] = data.get("kinematics")
 

@@ -3,21 +3,25 @@
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from ._schema import check_choice, check_flag, check_number, fail
 from .model import BaseModel
-from .results import Result
+from .results import Result, finished_run
 
 #: The coordinates a static or modal analysis may run in.
 STATIC_COORDINATES = ["absolute", "joint"]
+#: How a static or modal analysis does its linear algebra: "dense" (every mode, the damped ones
+#: too), "sparse" (large models in absolute coordinates, about linear in their size; modes: the
+#: lowest `count`, undamped) or "automatic" (sparse above 600 velocity coordinates).
+STATIC_METHODS = ["automatic", "dense", "sparse"]
 
 
 def _static_settings(coordinates: str, tolerance: float, max_iterations: int,
-                     load_stepping: bool, max_load_steps: int,
-                     relaxation: bool) -> Dict[str, Any]:
+                     load_stepping: bool, max_load_steps: int, relaxation: bool,
+                     method: str) -> Dict[str, Any]:
     for name, value in (("max_iterations", max_iterations), ("max_load_steps", max_load_steps)):
         if not isinstance(value, int) or isinstance(value, bool) or value < 1:
             fail(name, f"expected a whole number of at least 1, got {value!r}")
@@ -26,7 +30,8 @@ def _static_settings(coordinates: str, tolerance: float, max_iterations: int,
             "max_iterations": max_iterations,
             "load_stepping": check_flag(load_stepping, "load_stepping"),
             "max_load_steps": max_load_steps,
-            "relaxation": check_flag(relaxation, "relaxation")}
+            "relaxation": check_flag(relaxation, "relaxation"),
+            "method": check_choice(method, "method", STATIC_METHODS)}
 
 
 def _result(model: BaseModel, data: Dict[str, Any]) -> Result:
@@ -38,7 +43,7 @@ def _result(model: BaseModel, data: Dict[str, Any]) -> Result:
 
 def statics(model: BaseModel, *, coordinates: str = "absolute", tolerance: float = 1e-12,
             max_iterations: int = 60, load_stepping: bool = True, max_load_steps: int = 64,
-            relaxation: bool = True) -> Result:
+            relaxation: bool = True, method: str = "automatic") -> Result:
     """The static equilibrium near the model's pose, at rest under its loads, as one output row:
     `result.reaction(joint)` holds the mechanism there, a driver's multipliers hold its motion.
 
@@ -51,10 +56,42 @@ def statics(model: BaseModel, *, coordinates: str = "absolute", tolerance: float
     "squared_frequencies" (1/s^2, negative along an unstable direction) and "least_stiff" (the
     coordinates that move most along the least stiff direction, "pivot.angle" say). Raises
     odyn.SolverError when no equilibrium is found, naming a free motion the loads drive.
-    coordinates: "absolute" or "joint" (as in `simulate`)."""
+    coordinates: "absolute" or "joint" (as in `simulate`). method: "automatic", "dense" or
+    "sparse" (see STATIC_METHODS; the sparse method judges stability from the lowest six
+    squared frequencies)."""
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
-                                max_load_steps, relaxation)
+                                max_load_steps, relaxation, method)
     return _result(model, model.module.statics(model._core, settings))
+
+
+def quasi_statics(model: BaseModel, *, t_end: float = 1.0, output_interval: float = 1e-2,
+                  coordinates: str = "absolute", tolerance: float = 1e-12,
+                  max_iterations: int = 60, load_stepping: bool = True,
+                  max_load_steps: int = 64, relaxation: bool = True, method: str = "automatic",
+                  max_halvings: int = 8,
+                  progress: Optional[Callable[[float], None]] = None) -> Result:
+    """A sequence of static equilibria from t = 0 to t_end, a row every `output_interval`: time
+    moves the drivers (and any load given as a function of time) so slowly that the mechanism
+    rests at every instant. Each equilibrium is found as `statics` finds it (same settings),
+    from the last one, so the rows follow one branch of equilibria as a driver turns or a load
+    grows; a time whose equilibrium is not found is reached in up to `max_halvings` halves of
+    the step. `result.reaction(driver)` is the effort that holds the driver at each row (the
+    torque a slowly turned crank needs), and `result.statics` lists each row's summary.
+    Raises odyn.SolverError where no equilibrium is found, with the rows up to there as the
+    error's `result`; Ctrl-C raises odyn.Interrupted. progress(t) is called about every 0.2 s."""
+    t_end = check_number(t_end, "t_end")
+    if t_end < 0:
+        fail("t_end", f"expected an end time >= 0, got {t_end!r}")
+    if not isinstance(max_halvings, int) or isinstance(max_halvings, bool) or max_halvings < 0:
+        fail("max_halvings", f"expected a whole number of at least 0, got {max_halvings!r}")
+    settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
+                                max_load_steps, relaxation, method)
+    settings.update(t_end=t_end, max_halvings=max_halvings,
+                    output_interval=check_number(output_interval, "output_interval",
+                                                 positive=True))
+    data = model.module.quasi_statics(model._core, settings, progress)
+    data["summary"] = None
+    return finished_run(model, data)
 
 
 class Modes:
@@ -66,7 +103,8 @@ class Modes:
     one of each conjugate pair): eigenvalues (complex, 1/s), natural_frequencies (|s|, Hz),
     damped_frequencies (Im s, Hz), damping_ratios (-Re s / |s|). The linearization: basis
     (n x k, the minimal coordinates' motions), mass, damping, stiffness (k x k) and
-    state_matrix (2k x 2k, for (z, z')). equilibrium: the pose they are about, a Result.
+    state_matrix (2k x 2k, for (z, z')); the sparse method leaves these empty, and the damped
+    modes too where something damps. equilibrium: the pose they are about, a Result.
     body_shapes, body_motion(mode, body): the modes as the bodies' motions; animate(mode,
     path): a GIF of one."""
 
@@ -175,16 +213,24 @@ def _turned(quaternion: np.ndarray, turn: np.ndarray) -> np.ndarray:
 
 def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: bool = True,
           tolerance: float = 1e-12, max_iterations: int = 60, load_stepping: bool = True,
-          max_load_steps: int = 64, relaxation: bool = True) -> Modes:
+          max_load_steps: int = 64, relaxation: bool = True, method: str = "automatic",
+          count: int = 0) -> Modes:
     """The natural modes about the static equilibrium near the model's pose (found as
     `statics` finds it, with the same settings), or, with find_equilibrium=False, about the
     pose as it is (its joints closed), which must then balance its loads (odyn.SolverError
     names the coordinate that it does not). The stiffness holds the forces' and the
-    constraints' geometric stiffness, from differences of the equations of motion; dense, for
-    models of up to a few hundred coordinates. See `Modes`."""
+    constraints' geometric stiffness, from differences of the equations of motion. count: how
+    many of the lowest modes (0: all of them by the dense method, the lowest 20 by the sparse
+    one). method (see STATIC_METHODS): "dense" gives every mode, damped ones too; "sparse"
+    (large models in absolute coordinates, the default above 600 velocity coordinates) the
+    lowest `count` undamped ones by shift-invert Lanczos, the damped ones only where nothing
+    damps, and no `linearization` matrices. See `Modes`."""
+    if not isinstance(count, int) or isinstance(count, bool) or count < 0:
+        fail("count", f"expected a whole number of at least 0 (0: all), got {count!r}")
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
-                                max_load_steps, relaxation)
+                                max_load_steps, relaxation, method)
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")
+    settings["count"] = count
     data = model.module.modes(model._core, settings)
     found = data.pop("modes")
     return Modes(found, _result(model, data), model)

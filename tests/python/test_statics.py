@@ -152,3 +152,77 @@ def test_a_mode_moves_the_bodies_as_its_joint_coordinates_say(tmp_path):
     assert path.stat().st_size > 0
     with pytest.raises(odyn.SceneError, match="no moving body 'elbow'"):
         joint.body_motion(0, "elbow")
+
+
+def hanging_chain(links):
+    """`links` hinged bars of 1 m and 1 kg hanging straight down from the origin."""
+    m = odyn.PlanarModel()
+    for i in range(links):
+        m.add_body(name=f"link{i}", mass=1.0, inertia=1.0 / 12, position=[0, -0.5 - i])
+        m.add_revolute(name=f"hinge{i}", body_a="ground" if i == 0 else f"link{i - 1}",
+                       on_a=odyn.frame([0, 0 if i == 0 else -0.5]), body_b=f"link{i}",
+                       on_b=odyn.frame([0, 0.5]))
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    return m
+
+
+def test_the_sparse_method_finds_the_dense_lowest_modes():
+    """Shift-invert Lanczos on sparse matrices (absolute coordinates) against the dense
+    eigenproblem in joint coordinates: the lowest four of a 12-link chain's twelve modes."""
+    chain = hanging_chain(12)
+    sparse = odyn.modes(chain, method="sparse", count=4)
+    dense = odyn.modes(chain, coordinates="joint", method="dense")
+    assert len(sparse) == 4 and len(dense) == 12
+    np.testing.assert_allclose(sparse.frequencies, dense.frequencies[:4], rtol=1e-9)
+    # Nothing damps: the damped modes are the undamped ones; no reduced matrices.
+    np.testing.assert_allclose(sparse.natural_frequencies, dense.frequencies[:4], rtol=1e-9)
+    assert sparse.mass.size == 0
+    for k in range(4):
+        a, b = sparse.body_shapes[:, k], dense.body_shapes[:, k]
+        assert min(np.linalg.norm(a - b), np.linalg.norm(a + b)) < 1e-7 * np.linalg.norm(a)
+    at_rest = odyn.statics(chain, method="sparse")
+    assert at_rest.statics["stable"]
+    assert at_rest.statics["squared_frequencies"][0] == pytest.approx(
+        (2 * math.pi * dense.frequencies[0]) ** 2, rel=1e-9)
+    with pytest.raises(odyn.SceneError, match="method"):
+        odyn.modes(chain, method="fast")
+    with pytest.raises(odyn.SceneError, match="count"):
+        odyn.modes(chain, count=-1)
+    with pytest.raises(odyn.ModelError, match="absolute coordinates"):
+        odyn.modes(chain, coordinates="joint", method="sparse")
+
+
+def test_a_slowly_turned_crank_needs_the_virtual_work_torque():
+    """A slider-crank turned quasi-statically by its motor against a spring on the piston and
+    the bars' weight: at every angle the motor's torque is dV/dtheta, V the potential energy."""
+    r, rod, k, wall, free = 0.2, 0.5, 200.0, 1.0, 0.4
+    mass = {"crank": 1.0, "rod": 0.5, "piston": 2.0}
+    m = odyn.PlanarModel()
+    m.add_body(name="crank", mass=mass["crank"], inertia=0.01, position=[r / 2, 0])
+    m.add_body(name="rod", mass=mass["rod"], inertia=0.02, position=[r + rod / 2, 0])
+    m.add_body(name="piston", mass=mass["piston"], inertia=0.01, position=[r + rod, 0])
+    m.add_revolute(name="main", body_a="ground", body_b="crank", on_b=odyn.frame([-r / 2, 0]))
+    m.add_revolute(name="pin", body_a="crank", on_a=odyn.frame([r / 2, 0]), body_b="rod",
+                   on_b=odyn.frame([-rod / 2, 0]))
+    m.add_revolute(name="wrist", body_a="rod", on_a=odyn.frame([rod / 2, 0]), body_b="piston")
+    m.add_translational(name="cylinder", body_a="ground", on_a=odyn.frame([0, 0], [1, 0]),
+                        body_b="piston", on_b=odyn.frame([0, 0], [1, 0]))
+    m.add_tsda(name="spring", body_a="piston", point_a=[0, 0], body_b="ground",
+               point_b=[wall, 0], stiffness=k, damping=0.0, free_length=free)
+    m.add_gravity(name="gravity", acceleration=[0, -G])
+    m.add_revolute_driver(name="motor", joint="main", motion=odyn.constant_velocity(1.0))
+
+    result = odyn.quasi_statics(m, t_end=3.0, output_interval=0.1, coordinates="joint")
+    theta = result.t
+    assert len(theta) == 31 and len(result.statics) == 31
+    root = np.sqrt(rod ** 2 - (r * np.sin(theta)) ** 2)
+    x = r * np.cos(theta) + root
+    slope = -r * np.sin(theta) - r ** 2 * np.sin(theta) * np.cos(theta) / root
+    expected = (-k * (wall - x - free) * slope
+                + G * (mass["crank"] + mass["rod"]) * (r / 2) * np.cos(theta))
+    torque = result.reaction("motor").torque
+    np.testing.assert_allclose(torque, expected, atol=1e-9 * np.abs(expected).max())
+    np.testing.assert_allclose(result.body("piston").position[:, 0], x, atol=1e-12)
+    assert all(row["force_residual"] < 1e-12 for row in result.statics)
+    with pytest.raises(odyn.SceneError, match="max_halvings"):
+        odyn.quasi_statics(m, max_halvings=-1)

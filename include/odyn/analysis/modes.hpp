@@ -9,7 +9,8 @@
 // a minimal set of coordinates z, as many as the degrees of freedom. The undamped modes solve
 // K_r x = omega^2 M_r x (K_r's symmetric part); the damped ones are the eigenvalues s of the
 // state matrix [0 I; -M_r^-1 K_r, -M_r^-1 C_r], natural frequency |s| and damping ratio
-// -Re(s) / |s|. Dense: for models of up to a few hundred coordinates.
+// -Re(s) / |s|. Dense, O(n^3); large models in absolute coordinates take the sparse path
+// (analysis/sparse_linearization.hpp), which finds the lowest modes without forming T.
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -23,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "odyn/analysis/sparse_linearization.hpp"
 #include "odyn/analysis/statics.hpp"
 
 namespace odyn {
@@ -93,17 +95,8 @@ inline void undamped_modes(Modes& out, double t) {
   out.shapes = l.basis * solver.eigenvectors();
 }
 
-inline void damped_modes(Modes& out) {
-  const Eigen::Index k = out.linearization.mass.rows();
-  if (k == 0) return;
-  const Eigen::EigenSolver<Eigen::MatrixXd> solver(out.linearization.state_matrix(), false);
-  const Eigen::VectorXcd& all = solver.eigenvalues();
-  std::vector<std::complex<double>> kept;
-  // One of each conjugate pair; a real eigenvalue stands alone.
-  for (Eigen::Index i = 0; i < all.size(); ++i)
-    if (all[i].imag() >= 0.0) kept.push_back(all[i]);
-  std::sort(kept.begin(), kept.end(),
-            [](const auto& a, const auto& b) { return std::abs(a) < std::abs(b); });
+/// The damped modes' fields from their eigenvalues s (one of each conjugate pair).
+inline void set_damped(Modes& out, const std::vector<std::complex<double>>& kept) {
   const auto count = static_cast<Eigen::Index>(kept.size());
   out.eigenvalues.resize(count);
   out.natural_frequencies.resize(count);
@@ -119,40 +112,123 @@ inline void damped_modes(Modes& out) {
   }
 }
 
-/// The modes about the coordinates' held positions, at rest: the multipliers that balance the
-/// loads there first (least squares), refused if they leave an imbalance.
-template <class Coordinates>
-Modes modes_here(Coordinates& c, double t, double length) {
-  const Eigen::Index n = c.num_velocities();
-  c.velocities().setZero();
-  c.accelerations().setZero();
-  c.multipliers().setZero();
-  Eigen::VectorXd load(n), imbalance(n);
-  residual_here(c, load);
-  const Eigen::MatrixXd jacobian = constraint_jacobian(c);
-  if (jacobian.rows() > 0)
-    c.multipliers() = jacobian.transpose().completeOrthogonalDecomposition().solve(-load);
-  residual_here(c, imbalance);
-  Modes out;
-  out.coordinates = c.velocity_coordinates();
-  const Tangent tangent_here = tangent(c, length);
-  // Forces against the loads, or the stiffness times the model's size where that is more (the
-  // loads can cancel out at an equilibrium, body by body).
-  const double scale =
-      std::max({load.size() > 0 ? load.cwiseAbs().maxCoeff() : 0.0,
-                n > 0 ? tangent_here.stiffness.cwiseAbs().maxCoeff() * length : 0.0, 1e-300});
+inline void damped_modes(Modes& out) {
+  const Eigen::Index k = out.linearization.mass.rows();
+  if (k == 0) return;
+  const Eigen::EigenSolver<Eigen::MatrixXd> solver(out.linearization.state_matrix(), false);
+  const Eigen::VectorXcd& all = solver.eigenvalues();
+  std::vector<std::complex<double>> kept;
+  // One of each conjugate pair; a real eigenvalue stands alone.
+  for (Eigen::Index i = 0; i < all.size(); ++i)
+    if (all[i].imag() >= 0.0) kept.push_back(all[i]);
+  std::sort(kept.begin(), kept.end(),
+            [](const auto& a, const auto& b) { return std::abs(a) < std::abs(b); });
+  set_damped(out, kept);
+}
+
+/// Throws unless the force imbalance at a pose is negligible against its forces: the loads, or
+/// the stiffness times the model's size where that is more (the loads can cancel out at an
+/// equilibrium, body by body).
+inline void refuse_imbalance(const Eigen::VectorXd& imbalance, const Eigen::VectorXd& load,
+                             double largest_stiffness, double length,
+                             const std::vector<VelocityCoordinate>& coordinates, double t) {
+  const Eigen::Index n = imbalance.size();
+  const double scale = std::max({load.size() > 0 ? load.cwiseAbs().maxCoeff() : 0.0,
+                                 n > 0 ? largest_stiffness * length : 0.0, 1e-300});
   Eigen::Index worst = 0;
   if (n > 0 && imbalance.cwiseAbs().maxCoeff(&worst) > 1e-8 * scale)
     throw SolverError(t,
                       "modes are found about an equilibrium, and this pose is not one: a "
                       "force imbalance of " +
                           to_text(imbalance[worst]) + " on " +
-                          out.coordinates[static_cast<std::size_t>(worst)].text() +
+                          coordinates[static_cast<std::size_t>(worst)].text() +
                           " (against forces of " + to_text(scale) +
                           "). Find the equilibrium first (find_equilibrium)");
+}
+
+/// The coordinates at rest with the multipliers that best balance the loads there (least
+/// squares); `load` the residual without them.
+template <class Coordinates, class Algebra>
+void balanced_at_rest(Coordinates& c, Algebra algebra, Eigen::VectorXd& load) {
+  c.velocities().setZero();
+  c.accelerations().setZero();
+  c.multipliers().setZero();
+  load.resize(c.num_velocities());
+  residual_here(c, load);
+  if (c.num_equations() > 0) algebra.balance(c, load);
+}
+
+/// The modes about the coordinates' held positions, at rest: the multipliers that balance the
+/// loads there first (least squares), refused if they leave an imbalance.
+template <class Coordinates>
+Modes modes_here(Coordinates& c, double t, double length) {
+  const Eigen::Index n = c.num_velocities();
+  Eigen::VectorXd load, imbalance(n);
+  balanced_at_rest(c, DenseStaticAlgebra{}, load);
+  residual_here(c, imbalance);
+  Modes out;
+  out.coordinates = c.velocity_coordinates();
+  const Tangent tangent_here = tangent(c, length);
+  refuse_imbalance(imbalance, load, n > 0 ? tangent_here.stiffness.cwiseAbs().maxCoeff() : 0.0,
+                   length, out.coordinates, t);
   out.linearization = reduce(tangent_here);
   undamped_modes(out, t);
   damped_modes(out);
+  return out;
+}
+
+/// The lowest `count` undamped modes about the workspace's pose at rest, in absolute
+/// coordinates, by the sparse path (analysis/sparse_linearization.hpp). Damped ones too when
+/// no force damps (then s = +-i omega); with dampers they are left empty.
+template <class Model, class Solver>
+Modes sparse_modes_here(AbsoluteCoordinates<Model, Solver>& c, const Model& model,
+                        Workspace<Model>& ws, double length, int count) {
+  const Eigen::Index n = c.num_velocities();
+  Eigen::VectorXd load, imbalance(n);
+  balanced_at_rest(c, SparseStaticAlgebra<Model>(model, ws), load);
+  residual_here(c, imbalance);
+  const std::vector<int> rows = kept_rows(model, ws);
+  const Eigen::SparseMatrix<double> jacobian =
+      selected_rows(sparse_constraint_jacobian(model, ws), rows);
+  Modes out;
+  out.coordinates = c.velocity_coordinates();
+  const SparseTangent tangent_here = sparse_tangent(c, model, ws, length);
+  const double largest_stiffness = SparseStaticAlgebra<Model>::largest(tangent_here.stiffness);
+  refuse_imbalance(imbalance, load, largest_stiffness, length, out.coordinates, ws.t);
+  const LowestModes lowest =
+      lowest_modes(tangent_here.stiffness, tangent_here.mass, jacobian, count);
+  if (lowest.values.size() == 0 && count > 0 && n > static_cast<Eigen::Index>(rows.size()))
+    throw SolverError(ws.t,
+                      "the modes could not be found: the reduced mass matrix is not positive "
+                      "definite (a body without mass or inertia), or the stiffness is singular");
+  if (!lowest.converged)
+    throw SolverError(ws.t, "the lowest " + std::to_string(count) +
+                                " modes did not converge (Lanczos); ask for fewer, or use the "
+                                "dense method");
+  out.squared_frequencies = lowest.values;
+  out.frequencies = lowest.values.unaryExpr(
+      [](double w2) { return std::sqrt(std::max(w2, 0.0)) / (2.0 * std::numbers::pi); });
+  out.shapes = lowest.vectors;
+  // Nothing damps where C is rounding against sqrt(K M) (a damping ratio of 1e-12).
+  const auto largest = SparseStaticAlgebra<Model>::largest;
+  const bool damped = largest(tangent_here.damping) >
+                      1e-12 * std::sqrt(largest_stiffness * largest(tangent_here.mass));
+  if (!damped) {
+    // s = +-i omega, or +-sqrt(-omega^2) along an unstable direction (both kept, as the dense
+    // path keeps every real eigenvalue).
+    std::vector<std::complex<double>> kept;
+    for (const double w2 : lowest.values) {
+      if (w2 >= 0.0) {
+        kept.emplace_back(0.0, std::sqrt(w2));
+      } else {
+        kept.emplace_back(std::sqrt(-w2), 0.0);
+        kept.emplace_back(-std::sqrt(-w2), 0.0);
+      }
+    }
+    std::stable_sort(kept.begin(), kept.end(),
+                     [](const auto& a, const auto& b) { return std::abs(a) < std::abs(b); });
+    set_damped(out, kept);
+  }
   return out;
 }
 
@@ -186,7 +262,50 @@ struct ModeSettings {
   /// about the workspace's pose as it is, which must be an equilibrium at rest.
   bool find_equilibrium = true;
   StaticSettings statics = {};
+  /// How many of the lowest modes: 0 gives all of them by the dense method, the lowest
+  /// `sparse_default_count` by the sparse one.
+  int count = 0;
+  /// "dense": every mode and the damped ones, O(n^3); "sparse": the lowest `count` undamped
+  /// ones (analysis/sparse_linearization.hpp), in absolute coordinates, about linear in the
+  /// model's size; "automatic": sparse in absolute coordinates above `sparse_above` velocity
+  /// coordinates, else dense.
+  std::string method = "automatic";
+  static constexpr int sparse_default_count = 20;
+  static constexpr int sparse_above = 600;
 };
+
+namespace detail {
+/// Whether the modes take the sparse path; refuses a method that does not apply.
+template <class Model>
+bool sparse_modes(const Model& model, const ModeSettings& s) {
+  if (s.method != "automatic" && s.method != "dense" && s.method != "sparse")
+    throw ModelError("modal analysis",
+                     "method '" + s.method + "' unknown; use 'automatic', 'dense' or 'sparse'");
+  if (s.count < 0)
+    throw ModelError("modal analysis",
+                     "count must be 0 (all) or positive, got " + std::to_string(s.count));
+  if (s.method == "sparse" && s.coordinates != "absolute")
+    throw ModelError("modal analysis",
+                     "the sparse method runs in absolute coordinates; use coordinates "
+                     "'absolute' or the dense method");
+  return s.method == "sparse" || (s.method == "automatic" && s.coordinates == "absolute" &&
+                                  model.num_velocities() > ModeSettings::sparse_above);
+}
+
+/// The lowest `count` of the modes (all if 0 or more than there are).
+inline void keep_lowest(Modes& out, int count) {
+  if (count <= 0) return;
+  const auto undamped = std::min<Eigen::Index>(count, out.squared_frequencies.size());
+  out.squared_frequencies.conservativeResize(undamped);
+  out.frequencies.conservativeResize(undamped);
+  out.shapes.conservativeResize(Eigen::NoChange, undamped);
+  const auto damped = std::min<Eigen::Index>(count, out.eigenvalues.size());
+  out.eigenvalues.conservativeResize(damped);
+  out.natural_frequencies.conservativeResize(damped);
+  out.damped_frequencies.conservativeResize(damped);
+  out.damping_ratios.conservativeResize(damped);
+}
+}  // namespace detail
 
 /// The natural modes about the static equilibrium near the workspace's pose (left in the
 /// workspace; see static_equilibrium), or about the pose itself, its joints closed
@@ -197,8 +316,10 @@ Modes natural_modes(const Model& model, Workspace<Model>& ws, const ModeSettings
   if (s.coordinates != "absolute" && s.coordinates != "joint")
     throw ModelError("modal analysis",
                      "coordinates '" + s.coordinates + "' unknown; use 'absolute' or 'joint'");
+  const bool sparse = detail::sparse_modes(model, s);
   StaticSettings statics = s.statics;
   statics.coordinates = s.coordinates;
+  statics.method = s.method;
   if (s.find_equilibrium) {
     static_equilibrium(model, ws, statics);
   } else {
@@ -216,11 +337,16 @@ Modes natural_modes(const Model& model, Workspace<Model>& ws, const ModeSettings
   if (s.coordinates == "joint") {
     JointCoordinates<Model> c(model, ws);
     Modes out = detail::modes_here(c, ws.t, length);
+    detail::keep_lowest(out, s.count);
     out.body_shapes = detail::body_motions(c, model, ws, out.shapes);
     return out;
   }
-  AbsoluteCoordinates<Model> c(model, ws, LinearSolver::dense);
-  Modes out = detail::modes_here(c, ws.t, length);
+  AbsoluteCoordinates<Model> c(model, ws, sparse ? LinearSolver::automatic : LinearSolver::dense);
+  Modes out =
+      sparse ? detail::sparse_modes_here(c, model, ws, length,
+                                         s.count > 0 ? s.count : ModeSettings::sparse_default_count)
+             : detail::modes_here(c, ws.t, length);
+  detail::keep_lowest(out, s.count);
   out.body_shapes = out.shapes;
   return out;
 }

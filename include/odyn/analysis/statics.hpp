@@ -16,7 +16,8 @@
 //     imbalance does, which follow a heavily damped motion to a stable equilibrium.
 // The equilibrium found is then judged by the stiffness along the motions the joints allow:
 // the eigenvalues of K against M there (squared frequencies) name an unstable equilibrium (a
-// negative one) and its direction. Dense: for models of up to a few hundred coordinates.
+// negative one) and its direction. The linear algebra is dense (DenseStaticAlgebra, O(n^3)), or
+// sparse for large models in absolute coordinates (SparseStaticAlgebra, about O(n)).
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -27,11 +28,13 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "odyn/analysis/absolute_coordinates.hpp"
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/joint_coordinates.hpp"
+#include "odyn/analysis/sparse_linearization.hpp"
 #include "odyn/analysis/tangent.hpp"
 #include "odyn/core/errors.hpp"
 
@@ -48,6 +51,12 @@ struct StaticSettings {
   /// When load steps fail too, relax: iterate as a heavily damped motion would settle.
   bool relaxation = true;
   std::string coordinates = "absolute";  // or "joint" (see analysis/joint_coordinates.hpp)
+  /// "dense": tangents and solves as dense matrices, O(n^3); "sparse": in absolute coordinates,
+  /// about linear in the model's size (analysis/sparse_linearization.hpp), the stability judged
+  /// from the lowest few squared frequencies; "automatic": sparse in absolute coordinates above
+  /// `sparse_above` velocity coordinates, else dense.
+  std::string method = "automatic";
+  static constexpr int sparse_above = 600;
 };
 
 /// How stiff an equilibrium is along the motions its joints allow.
@@ -127,6 +136,7 @@ inline std::string listed(const std::vector<std::string>& names) {
 struct ReducedSpectrum {
   Eigen::VectorXd values;
   Eigen::MatrixXd directions;
+  double largest = 0.0;  // the largest |value|, or an estimate where only the lowest are known
 };
 inline ReducedSpectrum reduced_spectrum(const Tangent& t) {
   const Eigen::MatrixXd basis = null_space(t.jacobian, t.stiffness.cols());
@@ -141,19 +151,145 @@ inline ReducedSpectrum reduced_spectrum(const Tangent& t) {
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> plain(stiffness);
     out.values = plain.eigenvalues();
     out.directions = basis * plain.eigenvectors();
-    return out;
+  } else {
+    out.values = solver.eigenvalues();
+    out.directions = basis * solver.eigenvectors();
   }
-  out.values = solver.eigenvalues();
-  out.directions = basis * solver.eigenvectors();
+  out.largest = out.values.cwiseAbs().maxCoeff();
   return out;
 }
 
-/// Newton's method on the equilibrium, generic over the coordinates (see the file's comment).
-template <class Coordinates>
-class StaticSolver {
+/// Statics' linear algebra with dense matrices (see the file's comment).
+struct DenseStaticAlgebra {
+  using TangentType = Tangent;
+  template <class Coordinates>
+  Tangent tangent(Coordinates& c, double length) {
+    return odyn::tangent(c, length, {.mass = true, .damping = false});
+  }
+  static double largest(const Eigen::MatrixXd& matrix) {
+    return matrix.size() > 0 ? matrix.cwiseAbs().maxCoeff() : 0.0;
+  }
+  /// The least change of the positions (velocity coordinates) that removes Phi to first order,
+  /// constraints evaluated.
+  template <class Coordinates>
+  Eigen::VectorXd correction(Coordinates& c) {
+    const Eigen::MatrixXd jacobian = constraint_jacobian(c);
+    return jacobian.completeOrthogonalDecomposition().solve(-c.constraint_values());
+  }
+  /// The multipliers that best balance `residual` (evaluated with none), least squares.
+  template <class Coordinates>
+  void balance(Coordinates& c, const Eigen::VectorXd& residual) {
+    const Eigen::MatrixXd jacobian = constraint_jacobian(c);
+    c.multipliers() = jacobian.transpose().completeOrthogonalDecomposition().solve(-residual);
+  }
+  /// The Newton step for rhs with [K + mu M, Phi_q^T; Phi_q, 0]; false if the matrix is
+  /// singular and cannot balance rhs.
+  bool step(const Tangent& t, double mu, const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+    const Eigen::Index n = t.stiffness.rows(), m = t.jacobian.rows();
+    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(n + m, n + m);
+    matrix.topLeftCorner(n, n) = t.stiffness;
+    if (mu != 0.0) matrix.topLeftCorner(n, n) += mu * t.mass;
+    matrix.topRightCorner(n, m) = t.jacobian.transpose();
+    matrix.bottomLeftCorner(m, n) = t.jacobian;
+    const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver(matrix);
+    out = solver.solve(rhs);
+    return (matrix * out - rhs).norm() <= 1e-8 * rhs.norm();
+  }
+  ReducedSpectrum spectrum(const Tangent& t) { return reduced_spectrum(t); }
+};
+
+/// The same on sparse matrices for a large model in absolute coordinates: the constraint rows
+/// kept are those that repeat no others at the start pose, the spectrum the lowest few.
+template <class Model>
+class SparseStaticAlgebra {
  public:
-  StaticSolver(Coordinates& c, double t, double length, const StaticSettings& s)
-      : c_(c),
+  using TangentType = SparseTangent;
+  static constexpr int judged_modes = 6;  // the lowest squared frequencies found
+
+  SparseStaticAlgebra(const Model& model, Workspace<Model>& ws) : model_(model), ws_(ws) {
+    evaluate_constraints(model, ws);
+    rows_ = kept_rows(model, ws);
+  }
+  template <class Coordinates>
+  SparseTangent tangent(Coordinates& c, double length) {
+    return sparse_tangent(c, model_, ws_, length, {.mass = true, .damping = false});
+  }
+  static double largest(const Eigen::SparseMatrix<double>& matrix) {
+    double out = 0.0;
+    for (Eigen::Index k = 0; k < matrix.nonZeros(); ++k)
+      out = std::max(out, std::abs(matrix.valuePtr()[k]));
+    return out;
+  }
+  template <class Coordinates>
+  Eigen::VectorXd correction(Coordinates& c) {
+    const Eigen::SparseMatrix<double> jacobian = kept_jacobian();
+    const Eigen::Index n = jacobian.cols(), m = jacobian.rows();
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + m);
+    for (std::size_t i = 0; i < rows_.size(); ++i)
+      rhs[n + static_cast<Eigen::Index>(i)] = -c.constraint_values()[rows_[i]];
+    SparseSaddleSolve solver;
+    if (!solver.factorize(sparse_identity(n), jacobian)) return Eigen::VectorXd::Zero(n);
+    solver.solve_in_place(rhs);
+    return rhs.head(n);
+  }
+  template <class Coordinates>
+  void balance(Coordinates& c, const Eigen::VectorXd& residual) {
+    Eigen::VectorXd kept;
+    c.multipliers().setZero();
+    if (!least_squares_multipliers(kept_jacobian(), residual, kept)) return;
+    for (std::size_t i = 0; i < rows_.size(); ++i)
+      c.multipliers()[rows_[i]] = kept[static_cast<Eigen::Index>(i)];
+  }
+  bool step(const SparseTangent& t, double mu, const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+    const Eigen::Index n = t.stiffness.rows();
+    const auto m = static_cast<Eigen::Index>(rows_.size());
+    Eigen::VectorXd kept_rhs(n + m);
+    kept_rhs.head(n) = rhs.head(n);
+    for (Eigen::Index i = 0; i < m; ++i)
+      kept_rhs[n + i] = rhs[n + rows_[static_cast<std::size_t>(i)]];
+    SparseSaddleSolve solver;
+    const bool regular =
+        mu != 0.0 ? solver.factorize(t.stiffness + mu * t.mass, selected_rows(t.jacobian, rows_))
+                  : solver.factorize(t.stiffness, selected_rows(t.jacobian, rows_));
+    if (!regular) return false;
+    solver.solve_in_place(kept_rhs);
+    out = Eigen::VectorXd::Zero(rhs.size());
+    out.head(n) = kept_rhs.head(n);
+    for (Eigen::Index i = 0; i < m; ++i)
+      out[n + rows_[static_cast<std::size_t>(i)]] = kept_rhs[n + i];
+    return true;
+  }
+  ReducedSpectrum spectrum(const SparseTangent& t) {
+    const LowestModes lowest =
+        lowest_modes(t.stiffness, t.mass, selected_rows(t.jacobian, rows_), judged_modes);
+    ReducedSpectrum out;
+    out.values = lowest.values;
+    out.directions = lowest.vectors;
+    out.largest = std::max(lowest.values.size() > 0 ? lowest.values.cwiseAbs().maxCoeff() : 0.0,
+                           lowest.largest_ratio);
+    return out;
+  }
+
+ private:
+  Eigen::SparseMatrix<double> kept_jacobian() const {
+    return selected_rows(sparse_constraint_jacobian(model_, ws_), rows_);
+  }
+  const Model& model_;
+  Workspace<Model>& ws_;
+  std::vector<int> rows_;  // the constraint rows kept
+};
+
+/// Newton's method on the equilibrium, generic over the coordinates and the linear algebra
+/// (see the file's comment).
+template <class Coordinates, class Algebra = DenseStaticAlgebra>
+class StaticSolver {
+  using TangentType = typename Algebra::TangentType;
+
+ public:
+  StaticSolver(Coordinates& c, double t, double length, const StaticSettings& s,
+               Algebra algebra = {})
+      : algebra_(std::move(algebra)),
+        c_(c),
         s_(s),
         t_(t),
         length_(length),
@@ -195,8 +331,8 @@ class StaticSolver {
     detail::residual_here(c_, residual_);
     residual_ -= (1.0 - s) * start_load_;
   }
-  double force_scale(const Tangent& t) const {
-    const double stiffness = t.stiffness.size() > 0 ? t.stiffness.cwiseAbs().maxCoeff() : 0.0;
+  double force_scale(const TangentType& t) const {
+    const double stiffness = Algebra::largest(t.stiffness);
     return std::max({start_load_.size() > 0 ? start_load_.cwiseAbs().maxCoeff() : 0.0,
                      stiffness * length_, std::numeric_limits<double>::min()});
   }
@@ -222,9 +358,7 @@ class StaticSolver {
       if (!std::isfinite(phi)) return false;
       // Done at a tenth of the tolerance, or where rounding stops the corrections.
       if (phi <= 0.1 * phi_tolerance() || (k > 2 && phi > 0.5 * previous) || k == 20) break;
-      const Eigen::MatrixXd jacobian = constraint_jacobian(c_);
-      const Eigen::VectorXd correction =
-          jacobian.completeOrthogonalDecomposition().solve(-c_.constraint_values());
+      const Eigen::VectorXd correction = algebra_.correction(c_);
       const Eigen::VectorXd q = c_.positions();
       c_.integrate(q, correction, c_.positions());
     }
@@ -232,8 +366,7 @@ class StaticSolver {
     c_.multipliers().setZero();
     evaluate(s);
     if (m_ > 0) {
-      const Eigen::MatrixXd jacobian = constraint_jacobian(c_);
-      c_.multipliers() = jacobian.transpose().completeOrthogonalDecomposition().solve(-residual_);
+      algebra_.balance(c_, residual_);
       evaluate(s);
     }
     return true;
@@ -256,16 +389,16 @@ class StaticSolver {
     const int budget = relax ? 4 * s_.max_iterations : s_.max_iterations;
     double mu = -1.0, last_norm = 0.0;  // relax: the mass added to K (1/s^2), set at the start
     for (int it = 0;; ++it) {
-      const Tangent t = tangent(c_, length_, {.mass = true, .damping = false});
+      const TangentType t = algebra_.tangent(c_, length_);
       const double scale = force_scale(t);
       evaluate(s);
       if (converged(scale)) return true;
       if (it == budget) return give_up();
       ++iterations;
       const double norm = residual_.norm();
-      const double mass = t.mass.size() > 0 ? t.mass.cwiseAbs().maxCoeff() : 1.0;
+      const double mass = n_ > 0 ? Algebra::largest(t.mass) : 1.0;
       // Stiffness over mass: the scale of the squared frequencies.
-      const double mu_unit = (t.stiffness.cwiseAbs().maxCoeff() + scale / length_) / mass;
+      const double mu_unit = (Algebra::largest(t.stiffness) + scale / length_) / mass;
       if (relax) {
         // Switched evolution relaxation: mu falls as the imbalance does, down to Newton's 0.
         mu = mu < 0.0 ? mu_unit : mu * norm / last_norm;
@@ -277,15 +410,9 @@ class StaticSolver {
       rhs << -residual_, -c_.constraint_values();
       bool stepped = false;
       for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-        Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(n_ + m_, n_ + m_);
-        matrix.topLeftCorner(n_, n_) = t.stiffness;
-        if (relax) matrix.topLeftCorner(n_, n_) += mu * t.mass;
-        matrix.topRightCorner(n_, m_) = t.jacobian.transpose();
-        matrix.bottomLeftCorner(m_, n_) = t.jacobian;
-        const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver(matrix);
-        const Eigen::VectorXd step = solver.solve(rhs);
+        Eigen::VectorXd step;
         // A singular tangent that cannot balance the residual gives no step.
-        const bool consistent = (matrix * step - rhs).norm() <= 1e-8 * rhs.norm();
+        const bool consistent = algebra_.step(t, relax ? mu : 0.0, rhs, step);
         if (!relax) {
           for (double alpha = 1.0; consistent && alpha >= 1.0 / 64.0 && !stepped; alpha *= 0.5) {
             c_.integrate(q, alpha * step.head(n_), c_.positions());
@@ -330,16 +457,16 @@ class StaticSolver {
   }
 
   void finish(StaticSummary& out) {
-    const Tangent t = tangent(c_, length_, {.mass = true, .damping = false});
+    const TangentType t = algebra_.tangent(c_, length_);
     evaluate(1.0);
     out.force_scale = force_scale(t);
     out.force_residual = n_ > 0 ? residual_.cwiseAbs().maxCoeff() / out.force_scale : 0.0;
     out.constraint_residual = m_ > 0 ? c_.constraint_values().cwiseAbs().maxCoeff() : 0.0;
-    const ReducedSpectrum spectrum = reduced_spectrum(t);
+    const ReducedSpectrum spectrum = algebra_.spectrum(t);
     Stability& stability = out.stability;
     stability.squared_frequencies.assign(spectrum.values.begin(), spectrum.values.end());
     if (spectrum.values.size() == 0) return;
-    const double largest = spectrum.values.cwiseAbs().maxCoeff();
+    const double largest = spectrum.largest;
     // Below this, a squared frequency is the differences' rounding, not stiffness.
     const double noise = 1e-8 * std::max(largest, std::numeric_limits<double>::min());
     stability.stable = spectrum.values[0] >= -noise;
@@ -351,9 +478,9 @@ class StaticSolver {
   /// the reduced stiffness (against the mass), moving the model by its own size calls up less
   /// than a millionth of the load along it. The coordinates it moves most; empty if none.
   std::vector<std::string> free_motion() {
-    const Tangent t = tangent(c_, length_, {.mass = true, .damping = false});
+    const TangentType t = algebra_.tangent(c_, length_);
     evaluate(1.0);
-    const ReducedSpectrum spectrum = reduced_spectrum(t);
+    const ReducedSpectrum spectrum = algebra_.spectrum(t);
     for (Eigen::Index k = 0; k < spectrum.values.size(); ++k) {
       const Eigen::VectorXd direction = spectrum.directions.col(k);
       double size = 0.0;  // the direction's largest travel, turns counted through the size
@@ -392,6 +519,7 @@ class StaticSolver {
                               "loads can be balanced");
   }
 
+  Algebra algebra_;
   Coordinates& c_;
   const StaticSettings& s_;
   double t_;  // s: the time the drivers are held at
@@ -403,6 +531,20 @@ class StaticSolver {
   Eigen::VectorXd start_load_;  // (n) r0: the residual at the start pose, lambda = 0
   Eigen::VectorXd residual_;    // (n) the force imbalance at the held state
 };
+
+/// Whether statics take the sparse path; refuses a method that does not apply.
+template <class Model>
+bool sparse_statics(const Model& model, const StaticSettings& s) {
+  if (s.method != "automatic" && s.method != "dense" && s.method != "sparse")
+    throw ModelError("static analysis",
+                     "method '" + s.method + "' unknown; use 'automatic', 'dense' or 'sparse'");
+  if (s.method == "sparse" && s.coordinates != "absolute")
+    throw ModelError("static analysis",
+                     "the sparse method runs in absolute coordinates; use coordinates "
+                     "'absolute' or the dense method");
+  return s.method == "sparse" || (s.method == "automatic" && s.coordinates == "absolute" &&
+                                  model.num_velocities() > StaticSettings::sparse_above);
+}
 
 }  // namespace detail
 
@@ -417,6 +559,7 @@ StaticSummary static_equilibrium(const Model& model, Workspace<Model>& ws,
   if (s.coordinates != "absolute" && s.coordinates != "joint")
     throw ModelError("static analysis",
                      "coordinates '" + s.coordinates + "' unknown; use 'absolute' or 'joint'");
+  detail::sparse_statics(model, s);  // refuses a method that does not apply
   if (!(s.tolerance > 0.0) || !(s.max_iterations > 0) || !(s.max_load_steps > 0))
     throw ModelError("static analysis",
                      "tolerance, max_iterations and max_load_steps must be positive, got " +
@@ -437,6 +580,15 @@ StaticSummary static_equilibrium(const Model& model, Workspace<Model>& ws,
     c.evaluate_constraints();
     c.evaluate_forces();
     c.complete_workspace();
+    return out;
+  }
+  if (detail::sparse_statics(model, s)) {
+    AbsoluteCoordinates<Model> c(model, ws, LinearSolver::automatic);
+    const StaticSummary out =
+        detail::StaticSolver(c, ws.t, length, s, detail::SparseStaticAlgebra<Model>(model, ws))
+            .solve();
+    Eigen::VectorXd residual(c.num_velocities());
+    detail::residual_here(c, residual);  // the blocks and forces at the equilibrium
     return out;
   }
   AbsoluteCoordinates<Model> c(model, ws, LinearSolver::dense);

@@ -19,6 +19,7 @@
 
 #include <odyn/analysis/kinematics.hpp>
 #include <odyn/analysis/modes.hpp>
+#include <odyn/analysis/quasi_statics.hpp>
 #include <odyn/analysis/statics.hpp>
 #include <odyn/python/errors.hpp>
 #include <odyn/python/models.hpp>
@@ -73,6 +74,7 @@ inline StaticSettings static_settings(const py::dict& d) {
   s.max_load_steps = get(d, "max_load_steps", s.max_load_steps);
   s.relaxation = get(d, "relaxation", s.relaxation);
   s.coordinates = get(d, "coordinates", s.coordinates);
+  s.method = get(d, "method", s.method);
   return s;
 }
 
@@ -536,7 +538,9 @@ py::dict modes(Box& box, const py::dict& settings) {
   ModeSettings s;
   s.statics = static_settings(settings);
   s.coordinates = s.statics.coordinates;
+  s.method = s.statics.method;
   s.find_equilibrium = get(settings, "find_equilibrium", s.find_equilibrium);
+  s.count = get(settings, "count", s.count);
   auto [out, found] =
       recorded(box, [&](auto& ws) { return odyn::natural_modes(box.model, ws, s); });
   py::dict m;
@@ -604,6 +608,50 @@ py::dict kinematics(Box& box, const py::dict& settings, py::object progress,
   return out;
 }
 
+/// A quasi-static analysis (analysis/quasi_statics.hpp) from t = 0 to t_end, recorded as a run
+/// is: the rows, each row's static summary, and the exception that stopped it.
+template <class Box>
+py::dict quasi_statics(Box& box, const py::dict& settings, py::object progress,
+                       double progress_interval) {
+  using M = typename Box::ModelType;
+  QuasiStaticSettings s;
+  s.statics = static_settings(settings);
+  s.max_halvings = get(settings, "max_halvings", s.max_halvings);
+  const double t_end = get(settings, "t_end", 1.0);
+  const double interval = get(settings, "output_interval", 1e-2);
+  Running<Box> running(box);
+  odyn::Workspace<M> ws(box.model);
+  Recorder<M> recorder(box.model);
+  std::vector<StaticSummary> summaries;
+  std::exception_ptr error;
+  double wall_seconds = 0.0;
+  {
+    py::gil_scoped_release release;
+    box.monitor->start();
+    const auto start = std::chrono::steady_clock::now();
+    auto report = reporting(recorder, progress, progress_interval);
+    try {
+      odyn::quasi_static_analysis(
+          box.model, ws, t_end, interval,
+          [&](const odyn::Workspace<M>& state, const StaticSummary& summary) {
+            summaries.push_back(summary);
+            report(state);
+          },
+          s);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  py::dict out = recorder.to_python();
+  py::list rows;
+  for (const StaticSummary& summary : summaries) rows.append(static_summary(summary));
+  out["statics"] = rows;
+  out["wall_seconds"] = wall_seconds;
+  out["error"] = error ? python_exception(error) : py::object(py::none());
+  return out;
+}
+
 /// The model report at the assembled configuration: assembly's report and the mobility that
 /// the constraint Jacobian's rank gives (analysis/kinematics.hpp), as one output row.
 template <class Box>
@@ -646,6 +694,10 @@ void bind(py::module_& m) {
         py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
         "Runs a kinematic analysis; returns the recorded outputs, the summary (None if it "
         "stopped early) and the exception that stopped it (None if it finished).");
+  m.def("quasi_statics", &quasi_statics<Box>, py::arg("model"), py::arg("settings"),
+        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
+        "Runs a quasi-static analysis; returns the recorded equilibria, each one's summary and "
+        "the exception that stopped it (None if it finished).");
   m.def("check", &check<Box>, py::arg("model"), py::arg("settings"),
         "Assembles the model and reports its mobility; returns the assembled state as one "
         "output row, with the assembly's report and the mobility.");
