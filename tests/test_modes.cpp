@@ -1,6 +1,7 @@
 // Natural modes about an equilibrium (analysis/modes.hpp) against analytic spectra, in absolute
 // and joint coordinates.
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <complex>
@@ -260,6 +261,29 @@ TEST_CASE("Sparse statics and modes of a hanging chain agree with the dense join
   CHECK(a.stability.squared_frequencies[0] ==
         Approx(b.stability.squared_frequencies[0]).epsilon(1e-9));
   CHECK(a.force_residual < 1e-12);
+}
+
+TEST_CASE("Shift-invert Lanczos finds a pencil's largest theta through thick restarts", "[modes]") {
+  // K = diag(1..200), M = 2 I: Op = K^-1 M has theta_k = 2 / k. A basis of 14 vectors for 6
+  // pairs restarts several times; 5 unknowns exhaust the Krylov space before 8 pairs.
+  for (const int n : {200, 5}) {
+    CAPTURE(n);
+    const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(n, 1.0, double(n));
+    const auto apply = [&](const Eigen::Ref<const Eigen::VectorXd>& x,
+                           Eigen::Ref<Eigen::VectorXd> y) { y = 2.0 * x.cwiseQuotient(k); };
+    const auto mass = [](const Eigen::Ref<const Eigen::VectorXd>& x,
+                         Eigen::Ref<Eigen::VectorXd> y) { y = 2.0 * x; };
+    const int wanted = n == 200 ? 6 : 8;
+    const odyn::LanczosResult found =
+        odyn::shift_invert_lanczos(n, wanted, apply, mass, 14, 1e-12, 4000);
+    CHECK(found.converged);
+    const int pairs = std::min(wanted, n);
+    REQUIRE(found.values.size() == pairs);
+    if (n == 200) CHECK(found.operator_applications > 14);  // it restarted
+    for (int i = 0; i < pairs; ++i) CHECK(found.values[i] == Approx(2.0 / (i + 1)).epsilon(1e-10));
+    const Eigen::MatrixXd gram = 2.0 * found.vectors.transpose() * found.vectors;
+    CHECK((gram - Eigen::MatrixXd::Identity(pairs, pairs)).cwiseAbs().maxCoeff() < 1e-10);
+  }
 }
 
 TEST_CASE("A method or count that does not apply is refused by name", "[modes]") {
