@@ -20,7 +20,8 @@ elements compiled in.
 
 odyn.integrators(): the integrators by name, with what they are.
 Other analyses: odyn.kinematics (a fully driven mechanism, with the drivers' efforts),
-odyn.statics, odyn.quasi_statics (equilibria along a driver's motion), odyn.modes;
+odyn.statics, odyn.quasi_statics (equilibria along a driver's motion), odyn.modes,
+odyn.linearize (a state-space model for chosen inputs and outputs, about any state);
 odyn.check(model) reports its degrees of freedom and redundant equations.
 
 Scenes: odyn.load(path) -> Scene (model + analysis settings + outputs), odyn.save(scene, path).
@@ -42,6 +43,7 @@ from .results import (AssemblyWarning, BodyHistory, Event, Interrupted, PlanarBo
 from .scene import Scene, load, loads, save
 from .kinematics import ModelReport, check, kinematics
 from .statics import Modes, modes, quasi_statics, statics
+from .linear import LinearModel, linearize
 
 #: Every element type that Model.add accepts (and scenes, except user_force and
 #: user_constraint).
@@ -54,11 +56,11 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Event",
-    "Interrupted", "Model", "ModelError", "ModelReport", "Modes", "PlanarBodyHistory",
-    "PlanarModel", "PointHistory", "Reaction", "RedundantConstraintsWarning", "Result", "Scene",
-    "SceneError", "SolverError", "Statistics", "ToleranceWarning", "assemble", "check",
-    "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
-    "hunt_crossley_dissipation", "integrators", "kinematics", "load", "loads", "motion_function",
-    "modes", "planar_element_types", "polynomial", "quasi_statics", "save", "simulate",
-    "statics",
+    "Interrupted", "LinearModel", "Model", "ModelError", "ModelReport", "Modes",
+    "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction", "RedundantConstraintsWarning",
+    "Result", "Scene", "SceneError", "SolverError", "Statistics", "ToleranceWarning", "assemble",
+    "check", "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
+    "hunt_crossley_dissipation", "integrators", "kinematics", "linearize", "load", "loads",
+    "motion_function", "modes", "planar_element_types", "polynomial", "quasi_statics", "save",
+    "simulate", "statics",
 ]

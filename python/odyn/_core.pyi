@@ -73,6 +73,11 @@ def modes(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[st
     """The natural modes about the static equilibrium: the equilibrium's arrays for one output
     row and "modes" (frequencies, shapes, the damped eigenvalues, the linearization)."""
 
+def linearize(model: Union[Model, PlanarModel], settings: Dict[str, Any]) -> Dict[str, Any]:
+    """A state-space model about the model's state or its equilibrium: the state's arrays for
+    one output row and "linear_model" (a, b, c, d, drift, outputs, basis, coordinates,
+    input_names, output_names)."""
+
 def simulate(model: Union[Model, PlanarModel], settings: Dict[str, Any],
              progress: Optional[Callable[[float], None]] = None,
              progress_interval: float = 0.2) -> Dict[str, Any]:

@@ -21,7 +21,7 @@ from ._schema import fail
 REQUIRED = ("Model", "PlanarModel", "element_types", "planar_element_types",
             "element_catalogue", "planar_element_catalogue", "joint_kinds",
             "planar_joint_kinds", "assemble", "simulate", "statics", "modes", "kinematics",
-            "check", "quasi_statics")
+            "check", "quasi_statics", "linearize")
 
 _registered: Dict[str, ModuleType] = {"odyn._core": _core}
 

@@ -142,9 +142,7 @@ class AbsoluteCoordinates {
   void keep_tangential(Eigen::Ref<Eigen::VectorXd> error) {
     if (num_equations() == 0) return;
     constexpr int nq = Model::nq, nv = Model::nv;
-    for (int b = 0; b < model_.num_bodies(); ++b)
-      increment_.template segment<nv>(b * nv) = Model::Space::increment_of(
-          ws_.q.template segment<nq>(b * nq), error.template segment<nq>(b * nq));
+    increment_of(ws_.q, error.head(num_positions()), increment_);
     projection_.remove_normal_part(model_, ws_, solvers_[0], increment_);
     for (int b = 0; b < model_.num_bodies(); ++b)
       error.template segment<nq>(b * nq) = Model::Space::configuration_rate(
@@ -183,6 +181,17 @@ class AbsoluteCoordinates {
       Model::Space::integrate(from.template segment<nq>(b * nq),
                               increment.template segment<nv>(b * nv),
                               to.template segment<nq>(b * nq));
+  }
+
+  /// The increment whose rate of the positions at q is `change` (the inverse of the
+  /// configuration rate there): a quaternion's change along itself is dropped.
+  void increment_of(const Eigen::Ref<const Eigen::VectorXd>& q,
+                    const Eigen::Ref<const Eigen::VectorXd>& change,
+                    Eigen::Ref<Eigen::VectorXd> out) const {
+    constexpr int nq = Model::nq, nv = Model::nv;
+    for (int b = 0; b < model_.num_bodies(); ++b)
+      out.template segment<nv>(b * nv) = Model::Space::increment_of(
+          q.template segment<nq>(b * nq), change.template segment<nq>(b * nq));
   }
 
   /// positions() = q with q = beta + c T(q) w, T the configuration rate (affine in q, so that

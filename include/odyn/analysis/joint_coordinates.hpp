@@ -418,16 +418,7 @@ class JointCoordinates {
   /// quaternion's error is taken as a turn, its change of length dropped (load() normalizes).
   void keep_tangential(Eigen::Ref<Eigen::VectorXd> error) {
     if (num_equations() == 0) return;
-    for (const TreeBody& node : tree_) {
-      if (node.kind == Kind::free)
-        increment_.segment<Space::nv>(node.v_offset) = Space::increment_of(
-            q_.segment<Space::nq>(node.q_offset), error.segment<Space::nq>(node.q_offset));
-      else if (node.kind == Kind::ball)
-        increment_.segment<3>(node.v_offset) =
-            turn_of(q_.segment<4>(node.q_offset), error.segment<4>(node.q_offset));
-      else
-        increment_.segment(node.v_offset, node.dof()) = error.segment(node.q_offset, node.dof());
-    }
+    increment_of(q_, error.head(num_positions()), increment_);
     remove_normal_part(increment_);
     configuration_change(q_, increment_, error);
     remove_normal_part(error.tail(num_velocities()));
@@ -458,6 +449,23 @@ class JointCoordinates {
 
   /// The frames, motion columns and twists from positions() and velocities().
   void update_frames() { update_kinematics(); }
+
+  /// The increment in rate coordinates whose rate of the coordinates at q is `change` (the
+  /// inverse of the coordinates' rate there): a quaternion's change along itself is dropped.
+  void increment_of(const Eigen::Ref<const Eigen::VectorXd>& q,
+                    const Eigen::Ref<const Eigen::VectorXd>& change,
+                    Eigen::Ref<Eigen::VectorXd> out) const {
+    for (const TreeBody& node : tree_) {
+      if (node.kind == Kind::free)
+        out.segment<Space::nv>(node.v_offset) = Space::increment_of(
+            q.segment<Space::nq>(node.q_offset), change.segment<Space::nq>(node.q_offset));
+      else if (node.kind == Kind::ball)
+        out.segment<3>(node.v_offset) =
+            turn_of(q.segment<4>(node.q_offset), change.segment<4>(node.q_offset));
+      else
+        out.segment(node.v_offset, node.dof()) = change.segment(node.q_offset, node.dof());
+    }
+  }
 
   /// to = from moved by an increment in rate coordinates: a joint coordinate by its increment,
   /// a ball joint's or free root's rotation composed on the right.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <odyn/analysis/kinematics.hpp>
+#include <odyn/analysis/linear_model.hpp>
 #include <odyn/analysis/modes.hpp>
 #include <odyn/analysis/quasi_statics.hpp>
 #include <odyn/analysis/statics.hpp>
@@ -565,6 +566,79 @@ py::dict modes(Box& box, const py::dict& settings) {
   return out;
 }
 
+/// A Space vector from a list of numbers (the Python side checks their count).
+template <class Vector>
+Vector vector_from(const py::handle& values) {
+  const auto numbers = values.cast<std::vector<double>>();
+  Vector out;
+  for (Eigen::Index i = 0; i < out.size(); ++i) out[i] = numbers.at(static_cast<std::size_t>(i));
+  return out;
+}
+
+/// The state-space model about the model's state or its equilibrium (analysis/linear_model.hpp)
+/// for the inputs and outputs listed in `settings` (bodies and points by index, as events give
+/// them), with the state it was taken about as one output row.
+template <class Box>
+py::dict linearize(Box& box, const py::dict& settings) {
+  using M = typename Box::ModelType;
+  using Space = typename M::Space;
+  LinearizeSettings s;
+  s.statics = static_settings(settings);
+  s.coordinates = s.statics.coordinates;
+  s.find_equilibrium = get(settings, "find_equilibrium", s.find_equilibrium);
+  s.assembly = assembly_settings(settings);
+  std::vector<LinearInput<Space>> inputs;
+  for (const py::handle item : settings["inputs"].cast<py::list>()) {
+    const py::dict d = py::reinterpret_borrow<py::dict>(item);
+    LinearInput<Space> input;
+    input.name = d["name"].cast<std::string>();
+    input.body = BodyId{d["body"].cast<int>()};
+    input.force = vector_from<typename Space::Vector>(d["force"]);
+    input.torque = vector_from<typename Space::Angular>(d["torque"]);
+    input.point = vector_from<typename Space::Vector>(d["point"]);
+    input.axes = d["axes"].cast<std::string>() == "body" ? Axes::body : Axes::global;
+    inputs.push_back(std::move(input));
+  }
+  std::vector<LinearOutput<M>> outputs;
+  for (const py::handle item : settings["outputs"].cast<py::list>()) {
+    const py::dict d = py::reinterpret_borrow<py::dict>(item);
+    const auto name = d["name"].cast<std::string>();
+    if (d["kind"].cast<std::string>() == "output") {
+      LinearOutput<M> output = element_linear_output(box.model, d["element"].cast<std::string>(),
+                                                     d["output"].cast<std::string>());
+      output.name = name;
+      outputs.push_back(std::move(output));
+      continue;
+    }
+    const auto body = static_cast<std::size_t>(d["body"].cast<int>());
+    const auto local = vector_from<typename Space::Vector>(d["at"]);
+    const bool velocity = d["quantity"].cast<std::string>() == "velocity";
+    const int component = d["component"].cast<int>();
+    outputs.push_back({name, [=](const odyn::Workspace<M>& ws) {
+                         const auto& frame = ws.frames[body];
+                         return (velocity ? frame.point_velocity(local)
+                                          : frame.point(local))[component];
+                       }});
+  }
+  auto [out, found] =
+      recorded(box, [&](auto& ws) { return odyn::linearize(box.model, ws, inputs, outputs, s); });
+  py::dict l;
+  l["a"] = found.a;
+  l["b"] = found.b;
+  l["c"] = found.c;
+  l["d"] = found.d;
+  l["drift"] = found.drift;
+  l["outputs"] = found.outputs;
+  l["basis"] = found.basis;
+  std::vector<std::string> names;
+  for (const VelocityCoordinate& c : found.coordinates) names.push_back(c.text());
+  l["coordinates"] = names;
+  l["input_names"] = found.input_names;
+  l["output_names"] = found.output_names;
+  out["linear_model"] = l;
+  return out;
+}
+
 inline KinematicSettings kinematic_settings(const py::dict& d) {
   KinematicSettings s;
   s.tolerance = get(d, "tolerance", s.tolerance);
@@ -681,8 +755,8 @@ py::dict check(Box& box, const py::dict& settings) {
   return out;
 }
 
-/// Registers assemble, simulate, kinematics, check, statics and modes for one model type (pybind11
-/// overloads by the model).
+/// Registers assemble, simulate, kinematics, check, statics, modes and linearize for one model
+/// type (pybind11 overloads by the model).
 template <class Box>
 void bind(py::module_& m) {
   m.def("statics", &statics<Box>, py::arg("model"), py::arg("settings"),
@@ -690,6 +764,9 @@ void bind(py::module_& m) {
   m.def("modes", &modes<Box>, py::arg("model"), py::arg("settings"),
         "Finds the natural modes about the static equilibrium; returns the equilibrium as one "
         "output row, with the modes.");
+  m.def("linearize", &linearize<Box>, py::arg("model"), py::arg("settings"),
+        "Linearizes about the model's state or its equilibrium for the given inputs and "
+        "outputs; returns the state as one output row, with the state-space model.");
   m.def("kinematics", &kinematics<Box>, py::arg("model"), py::arg("settings"),
         py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
         "Runs a kinematic analysis; returns the recorded outputs, the summary (None if it "
