@@ -102,17 +102,22 @@ void accelerations_at(Coordinates& c, const Eigen::VectorXd& q, const Eigen::Vec
                       "configuration, or a motion that moves no mass): it cannot be linearized");
 }
 
-/// The generalized force, in the coordinates' velocity space, of `input` at the loaded state
-/// with the accelerations and multipliers held: the change it makes to the residual.
-template <class Coordinates, class Model>
-Eigen::VectorXd input_load(Coordinates& c, const Model& model, Workspace<Model>& ws,
-                           const LinearInput<typename Model::Space>& input) {
-  using Space = typename Model::Space;
+/// Throws unless `input` loads one of the model's moving bodies with finite numbers.
+template <class Model>
+void check_input(const Model& model, const LinearInput<typename Model::Space>& input) {
   if (input.body.index < 1 || input.body.index > model.num_bodies())
     throw ModelError(input.name, "body " + std::to_string(input.body.index) +
                                      " is not one of the model's moving bodies");
   if (!input.force.allFinite() || !input.torque.allFinite() || !input.point.allFinite())
     throw ModelError(input.name, "force, torque and point must be finite");
+}
+
+/// The generalized force, in the coordinates' velocity space, of `input` at the loaded state
+/// with the accelerations and multipliers held: the change it makes to the residual.
+template <class Coordinates, class Model>
+Eigen::VectorXd input_load(Coordinates& c, Workspace<Model>& ws,
+                           const LinearInput<typename Model::Space>& input) {
+  using Space = typename Model::Space;
   const Eigen::Index n = c.num_velocities();
   Eigen::VectorXd before(n), after(n);
   residual_here(c, before);
@@ -139,7 +144,10 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
   const Eigen::VectorXd q0 = c.positions(), v0 = c.velocities();
   StateSpace out;
   out.coordinates = c.velocity_coordinates();
-  for (const auto& input : inputs) out.input_names.push_back(input.name);
+  for (const auto& input : inputs) {
+    check_input(model, input);
+    out.input_names.push_back(input.name);
+  }
   for (const auto& output : outputs) {
     if (!output.value) throw ModelError(output.name, "the output has no function");
     out.output_names.push_back(output.name);
@@ -218,7 +226,7 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
   c.multipliers() = lambda0;
   out.b = Eigen::MatrixXd::Zero(2 * k, p);
   out.d = Eigen::MatrixXd::Zero(r, p);
-  if (p > 0) {
+  if (p > 0 && k > 0) {  // a mechanism that cannot move has no response to a load
     Eigen::VectorXd at_state(n), unit(n);
     residual_here(c, at_state);
     Eigen::MatrixXd mass(n, n);  // dr/dv', exact: r is linear in v'
@@ -235,10 +243,9 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
       throw SolverError(t,
                         "the reduced mass matrix is not positive definite: a motion the joints "
                         "allow moves no mass (a body without mass or inertia)");
-    residual_here(c, at_state);
     for (Eigen::Index i = 0; i < p; ++i)
-      out.b.col(i).tail(k) = inertia.solve(
-          basis.transpose() * input_load(c, model, ws, inputs[static_cast<std::size_t>(i)]));
+      out.b.col(i).tail(k) =
+          inertia.solve(basis.transpose() * input_load(c, ws, inputs[static_cast<std::size_t>(i)]));
   }
   // The workspace as found: the state, its accelerations and multipliers.
   accelerations_at(c, q0, v0, t);
