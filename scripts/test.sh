@@ -10,7 +10,11 @@ jobs=$(nproc)
 # Let ccache hit across checkouts (CI builds in a fresh clone) and across build directories.
 export CCACHE_BASEDIR=$root CCACHE_NOHASHDIR=true
 
-section() { printf '\n===== %s =====\n' "$*"; }
+# Each section says when it starts (seconds since CI began, or since this script began), so that
+# a run that nears CI's limit shows where its time went.
+start=${ODYN_CI_START:-$(date +%s)}
+stamp() { echo "$(($(date +%s) - start)) s"; }
+section() { printf '\n===== %s (at %s) =====\n' "$*" "$(stamp)"; }
 
 # configure <build dir> <cmake args...>: Ninja for a new tree; an existing tree keeps its generator.
 configure() {
@@ -46,7 +50,8 @@ finish() {
 section "Beside the sanitizer build: the Python package, the Release examples, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-CMAKE_BUILD_PARALLEL_LEVEL=1 nice -n 10 bash scripts/setup.sh >"$python_log" 2>&1 &
+(CMAKE_BUILD_PARALLEL_LEVEL=1 nice -n 10 bash scripts/setup.sh && echo "Built at $(stamp)") \
+  >"$python_log" 2>&1 &
 python_pid=$!
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=ON -DODYN_BUILD_BENCH=ON
@@ -56,17 +61,20 @@ cmake --install build --prefix build/install >/dev/null
 release_log=build/release.log
 (
   while kill -0 "$python_pid" 2>/dev/null; do sleep 5; done  # after the Python package's units
+  echo "Release examples from $(stamp)"
   nice -n 10 cmake --build build -j 1 --target engine slider_crank_planar four_bar andrews
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
     -DCMAKE_PREFIX_PATH="$root/build/install"
   nice -n 10 cmake --build build/downstream -j 1
-  echo "Install + downstream find_package(odyn):"
+  echo "Install + downstream find_package(odyn) at $(stamp):"
   ./build/downstream/odyn_downstream
   # The benchmarks that CI runs briefly after this script: built here, on the core that the
   # sanitizer build leaves free (it takes about 20 min longer than this chain), not after it.
+  echo "Benchmarks from $(stamp)"
   nice -n 10 cmake --build build -j 1 --target odyn_bench work_precision scaling
+  echo "Done at $(stamp)"
 ) >"$release_log" 2>&1 &
 release_pid=$!
 
