@@ -17,12 +17,9 @@ from .kinematics import check
 from .model import new_model
 from .results import (ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Interrupted, Result,
                       chosen_integrator, integrators)
-from .scene import ANALYSES, Scene, load, write_table
+from .linear import LinearModel
+from .scene import ANALYSES, TIMED, Scene, load, write_table
 from .statics import Modes
-
-
-#: The analyses that run through time (the others give one configuration).
-TIMED = ("dynamic", "kinematic")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -38,8 +35,10 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("scene", help="scene file (JSON)")
     run.add_argument("--analysis", choices=list(ANALYSES),
                      help="dynamic, kinematic (a fully driven mechanism, with its drivers' "
-                     "efforts), static (the equilibrium) or modes (the natural modes about it); "
-                     "default: the scene's \"type\", else dynamic")
+                     "efforts), quasi_static (equilibria as the drivers move), static (the "
+                     "equilibrium), modes (the natural modes about it) or linear (a "
+                     "state-space model for the scene's inputs and outputs); default: the "
+                     "scene's \"type\", else dynamic")
     run.add_argument("--t-end", type=float, help="end time, s")
     run.add_argument("--h", type=float, dest="step", help="step size, s")
     run.add_argument("--dt-out", type=float, dest="output_interval", help="output interval, s")
@@ -222,6 +221,8 @@ def _run(args: argparse.Namespace) -> int:
         if drawn:
             raise ValueError(f"{', '.join(drawn)}: draws a run against time; a {kind} analysis "
                              "gives one configuration")
+        if kind == "linear":
+            return _run_linear(args, scene, settings)
         return _run_at_rest(args, scene, kind, settings)
     progress = _Progress(settings["t_end"], not args.quiet and sys.stderr.isatty())
     start = time.monotonic()
@@ -256,7 +257,7 @@ def _run(args: argparse.Namespace) -> int:
         target = f" -> {args.out}" if args.out else ""
         print(f"odyn: {args.scene}{target}")
         lines = (summary_lines(scene, result, settings, wall) if kind == "dynamic"
-                 else kinematic_lines(scene, result, settings, wall))
+                 else kinematic_lines(scene, result, settings, wall, kind))
         print("\n".join(lines))
     if interrupted:
         print(f"odyn: interrupted; kept {len(result)} outputs up to t = "
@@ -271,14 +272,21 @@ def _final_columns(scene: Scene, result: Result) -> List[str]:
     return ["  final: " + ", ".join(shown)] if shown else []
 
 
-def kinematic_lines(scene: Scene, result: Result, settings: dict, wall: float) -> List[str]:
+def kinematic_lines(scene: Scene, result: Result, settings: dict, wall: float,
+                    kind: str = "kinematic") -> List[str]:
+    """The summary of a kinematic or quasi-static analysis: its residuals and its drivers'
+    largest efforts."""
     m = scene.model
-    lines = [f"kinematic analysis, t_end = {settings['t_end']:g} s: {len(result)} outputs"
-             + ("  [INTERRUPTED]" if result.interrupted else ""),
+    lines = [f"{kind.replace('_', '-')} analysis, t_end = {settings['t_end']:g} s: "
+             f"{len(result)} outputs" + ("  [INTERRUPTED]" if result.interrupted else ""),
              f"  {m.space} model: {m.num_velocities} coordinates, {m.num_equations} constraint "
              f"equations, wall time {wall:.3f} s"]
     if len(result):
-        lines.append(f"  largest residual: |Phi| {np.max(result.phi_norm):.2e}")
+        residual = f"  largest residual: |Phi| {np.max(result.phi_norm):.2e}"
+        if result.statics:
+            residual += (", force imbalance "
+                         f"{max(row['force_residual'] for row in result.statics):.2e}")
+        lines.append(residual)
         for name in result.joint_names:
             if m.element_type(name) in _schema.DRIVERS:
                 r = result.reaction(name)
@@ -352,6 +360,57 @@ def _run_at_rest(args: argparse.Namespace, scene: Scene, kind: str, settings: di
     return 0
 
 
+def eigenvalue_table(found: LinearModel) -> dict:
+    """A state-space model's eigenvalues as columns: real and imag (1/s), natural_frequency
+    (|s| / 2 pi, Hz) and damping_ratio (-Re s / |s|; NaN at s = 0)."""
+    s = found.eigenvalues
+    size = np.abs(s)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(size > 0, -s.real / size, np.nan)
+    return {"eigenvalue": np.arange(1, len(s) + 1, dtype=float), "real": s.real, "imag": s.imag,
+            "natural_frequency": size / (2 * np.pi), "damping_ratio": ratio}
+
+
+def _run_linear(args: argparse.Namespace, scene: Scene, settings: dict) -> int:
+    """A linear analysis: the state-space model to an .npz file (its matrices and names), or
+    its eigenvalues to a .csv file, and a summary."""
+    start = time.monotonic()
+    found = scene.run("linear", **settings)
+    assert isinstance(found, LinearModel)
+    wall = time.monotonic() - start
+    table = eigenvalue_table(found)
+    if args.out and args.out.endswith(".npz"):
+        np.savez(args.out, a=found.a, b=found.b, c=found.c, d=found.d, drift=found.drift,
+                 outputs_at_state=found.outputs_at_state, basis=found.basis,
+                 coordinates=np.array(found.coordinates, dtype=str),
+                 inputs=np.array(found.inputs, dtype=str),
+                 outputs=np.array(found.outputs, dtype=str),
+                 states=np.array(found.states, dtype=str), eigenvalues=found.eigenvalues)
+    elif args.out:
+        write_table(table, args.out)
+    if args.quiet:
+        return 0
+    target = f" -> {args.out}" if args.out else ""
+    print(f"odyn: {args.scene}{target}")
+    m = scene.model
+    about = "the equilibrium" if settings.get("find_equilibrium") else "the initial state"
+    print(f"linear analysis about {about}: {m.space} model, {m.num_velocities} coordinates, "
+          f"wall time {wall:.3f} s")
+    k = found.degrees_of_freedom
+    print(f"  {2 * k} states ({k} degree{'' if k == 1 else 's'} of freedom), "
+          f"{len(found.inputs)} inputs ({', '.join(found.inputs) or '-'}), "
+          f"{len(found.outputs)} outputs ({', '.join(found.outputs) or '-'})")
+    print(f"  |drift| {np.linalg.norm(found.drift):.2e} (zero at an equilibrium)")
+    shown = min(len(table["real"]), 12)
+    if shown:
+        print("  eigenvalues, smallest first (real, imaginary, 1/s; natural frequency, Hz; "
+              "damping ratio):")
+    for i in range(shown):
+        print(f"  {i + 1:4d}  {table['real'][i]:12.6g}  {table['imag'][i]:12.6g}  "
+              f"{table['natural_frequency'][i]:12.6g}  {table['damping_ratio'][i]:9.4g}")
+    return 0
+
+
 def _check(args: argparse.Namespace) -> int:
     """The scene's validity, its model and analysis, and the model report (odyn.check): the
     degrees of freedom, the redundant equations and what the assembly did."""
@@ -365,9 +424,17 @@ def _check(args: argparse.Namespace) -> int:
     if kind == "dynamic":
         print(f"  analysis: {describe_integrator(a)}, t_end {a['t_end']:g} s, output every "
               f"{a['output_interval']:g} s")
-    elif kind == "kinematic":
-        print(f"  analysis: kinematic, t_end {a['t_end']:g} s, output every "
-              f"{a['output_interval']:g} s")
+    elif kind in TIMED:
+        coordinates = f", in {a.get('coordinates', 'absolute')} coordinates" * (
+            kind == "quasi_static")
+        print(f"  analysis: {kind.replace('_', '-')}, t_end {a['t_end']:g} s, output every "
+              f"{a['output_interval']:g} s{coordinates}")
+    elif kind == "linear":
+        about = "the equilibrium" if a.get("find_equilibrium") else "the initial state"
+        print(f"  analysis: linear about {about}, in {a.get('coordinates', 'absolute')} "
+              f"coordinates; inputs: {', '.join(a.get('inputs', {})) or '-'}; outputs: "
+              + (", ".join(o if isinstance(o, str) else ".".join(o)
+                           for o in a.get("outputs", [])) or "-"))
     else:
         print(f"  analysis: {kind}, in {a.get('coordinates', 'absolute')} coordinates")
     print(f"  outputs: t, {', '.join(o['name'] for o in scene.outputs)}")

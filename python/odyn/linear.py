@@ -80,8 +80,7 @@ class LinearModel:
                 f"{self.inputs}, outputs {self.outputs})")
 
 
-def _input(model: BaseModel, name: str, given: Any) -> Dict[str, Any]:
-    where = f"inputs[{name!r}]"
+def _input(model: BaseModel, name: str, given: Any, where: str) -> Dict[str, Any]:
     _schema.check_name(name, where)
     if not isinstance(given, Mapping):
         fail(where, "expected {'body': ..., 'force': ..., 'torque': ..., 'point': ..., "
@@ -106,8 +105,7 @@ def _input(model: BaseModel, name: str, given: Any) -> Dict[str, Any]:
             "axes": check_choice(d.get("axes", "global"), f"{where}.axes", INPUT_AXES)}
 
 
-def _output(model: BaseModel, given: Output, i: int) -> Dict[str, Any]:
-    where = f"outputs[{i}]"
+def _output(model: BaseModel, given: Output, where: str) -> Dict[str, Any]:
     parts: Tuple[str, ...]
     if isinstance(given, str):
         parts = tuple(given.split("."))
@@ -130,6 +128,26 @@ def _output(model: BaseModel, given: Output, i: int) -> Dict[str, Any]:
     raise AssertionError  # fail() raises
 
 
+def check_inputs(model: BaseModel, inputs: Any, where: str = "inputs") -> List[Dict[str, Any]]:
+    """A linearization's inputs, {name: load}, checked against the model (see linearize)."""
+    if not isinstance(inputs, Mapping):
+        fail(where, f"expected {{name: load}}, got {inputs!r}")
+    return [_input(model, name, given, f"{where}[{name!r}]") for name, given in inputs.items()]
+
+
+def check_outputs(model: BaseModel, outputs: Any, where: str = "outputs"
+                  ) -> List[Dict[str, Any]]:
+    """A linearization's outputs, a list, checked against the model (see linearize)."""
+    if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
+        fail(where, f"expected a list of outputs, got {outputs!r}")
+    found = [_output(model, given, f"{where}[{i}]") for i, given in enumerate(outputs)]
+    names = [o["name"] for o in found]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        fail(where, f"{', '.join(repeated)} listed more than once")
+    return found
+
+
 def linearize(model: BaseModel, *, inputs: Optional[Mapping[str, Mapping[str, Any]]] = None,
               outputs: Sequence[Output] = (), coordinates: str = "absolute",
               find_equilibrium: bool = False, tolerance: float = 1e-12,
@@ -146,21 +164,11 @@ def linearize(model: BaseModel, *, inputs: Optional[Mapping[str, Mapping[str, An
     points' positions or velocities ("tip.velocity.x"). The matrices come from differences of
     the constrained dynamics themselves, independently of odyn.modes' stiffness and damping.
     coordinates: "absolute" or "joint" (the state's chart follows them)."""
-    if inputs is None:
-        inputs = {}
-    if not isinstance(inputs, Mapping):
-        fail("inputs", f"expected {{name: load}}, got {inputs!r}")
-    if isinstance(outputs, str) or not isinstance(outputs, (list, tuple)):
-        fail("outputs", f"expected a list of outputs, got {outputs!r}")
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
                                 max_load_steps, relaxation, "dense")
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")
-    settings["inputs"] = [_input(model, name, given) for name, given in inputs.items()]
-    settings["outputs"] = [_output(model, given, i) for i, given in enumerate(outputs)]
-    names = [o["name"] for o in settings["outputs"]]
-    repeated = sorted({n for n in names if names.count(n) > 1})
-    if repeated:
-        fail("outputs", f"{', '.join(repeated)} listed more than once")
+    settings["inputs"] = check_inputs(model, {} if inputs is None else inputs)
+    settings["outputs"] = check_outputs(model, outputs)
     data = model.module.linearize(model._core, settings)
     found = data.pop("linear_model")
     return LinearModel(found, _result(model, data))

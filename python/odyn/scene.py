@@ -27,7 +27,12 @@
                    generalized-alpha when a step is given without rtol and atol;
                    "type": "dynamic" (the default), "kinematic" (odyn.kinematics: t_end,
                    output_interval, max_iterations), "static" or "modes" (odyn.statics,
-                   odyn.modes: max_iterations, coordinates "absolute" or "joint"))
+                   odyn.modes: max_iterations, coordinates "absolute" or "joint"),
+                   "quasi_static" (odyn.quasi_statics: t_end, output_interval,
+                   max_iterations, coordinates, max_halvings) or "linear" (odyn.linearize:
+                   "inputs": {name: {"body": ..., "force": ..., "torque": ...}}, "outputs":
+                   ["spring.length", "tip.velocity.x"], find_equilibrium, max_iterations,
+                   coordinates))
       "outputs": [{"name": "z_piston", "body": "piston", "quantity": "position",
                    "component": "z"},
                   {"name": "pin_vx", "point": "pin", "quantity": "velocity", "component": "x"},
@@ -54,11 +59,13 @@ from typing import (Any, Callable, Dict, List, Mapping, NoReturn, Optional, Sequ
 import numpy as np
 
 from . import _schema, modules
-from ._schema import SceneError, check_choice, check_keys, check_name, check_number, fail
+from ._schema import (SceneError, check_choice, check_flag, check_keys, check_name,
+                      check_number, fail)
 from .model import BaseModel, Model, new_model
 from .kinematics import kinematics
 from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
-from .statics import STATIC_COORDINATES, Modes, modes, statics
+from .linear import LinearModel, check_inputs, check_outputs, linearize
+from .statics import STATIC_COORDINATES, Modes, modes, quasi_statics, statics
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
@@ -85,16 +92,20 @@ ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 ANALYSIS_OPTIONAL = ("type", "integrator", "rho_inf", "step", "rtol", "atol", "max_step",
                      "adaptive", "newton_rtol", "newton_atol", "constraint_tolerance",
                      "max_iterations", "projection_tolerance", "order", "coordinates",
-                     "linear_solver")
+                     "linear_solver", "max_halvings", "find_equilibrium", "inputs", "outputs")
 
 #: The analyses a scene may name ("type"), and the settings each takes beyond t_end and
-#: output_interval (which only the dynamic and kinematic analyses use).
+#: output_interval (which only the analyses in TIMED use).
 ANALYSES: Dict[str, Tuple[str, ...]] = {
-    "dynamic": ANALYSIS_OPTIONAL[1:],
+    "dynamic": ANALYSIS_OPTIONAL[1:ANALYSIS_OPTIONAL.index("max_halvings")],
     "kinematic": ("max_iterations",),
+    "quasi_static": ("max_iterations", "coordinates", "max_halvings"),
     "static": ("max_iterations", "coordinates"),
     "modes": ("max_iterations", "coordinates"),
+    "linear": ("max_iterations", "coordinates", "find_equilibrium", "inputs", "outputs"),
 }
+#: The analyses that run through time, from 0 to t_end (the others give one configuration).
+TIMED = ("dynamic", "kinematic", "quasi_static")
 
 BODY_QUANTITIES = ("position", "orientation", "linear_velocity", "angular_velocity",
                    "linear_acceleration", "angular_acceleration")
@@ -118,6 +129,10 @@ class Scene:
                  figures: Optional[List[Dict[str, Any]]] = None, description: str = "") -> None:
         self.model: BaseModel = model if model is not None else Model()
         self.analysis: Dict[str, Any] = _check_analysis(dict(analysis or {}), "analysis")
+        if "inputs" in self.analysis:  # a linear analysis's loads and outputs name the model's
+            check_inputs(self.model, self.analysis["inputs"], "analysis.inputs")
+        if "outputs" in self.analysis:
+            check_outputs(self.model, self.analysis["outputs"], "analysis.outputs")
         self.outputs: List[Dict[str, Any]] = [
             _check_output(o, f"outputs[{i}]", self.model) for i, o in enumerate(outputs or [])]
         _check_unique([o["name"] for o in self.outputs], "outputs", extra=["t"])
@@ -134,17 +149,17 @@ class Scene:
 
     @property
     def analysis_type(self) -> str:
-        """The analysis the scene names: "dynamic" (the default), "kinematic", "static" or
-        "modes"."""
+        """The analysis the scene names: "dynamic" (the default), "kinematic",
+        "quasi_static", "static", "modes" or "linear"."""
         return self.analysis.get("type", "dynamic")
 
     def run(self, analysis: Optional[str] = None,
             progress: Optional[Callable[[float], None]] = None,
-            **overrides: Any) -> Union[Result, Modes]:
-        """Runs the scene's analysis, or `analysis` instead ("dynamic", "kinematic", "static"
-        or "modes", whose settings the scene's do not then need to fit: those of another
-        analysis are left out); keyword arguments override its settings. Returns a Result,
-        or Modes for "modes"."""
+            **overrides: Any) -> Union[Result, Modes, LinearModel]:
+        """Runs the scene's analysis, or `analysis` instead (one of ANALYSES, whose settings
+        the scene's do not then need to fit: those of another analysis are left out); keyword
+        arguments override its settings. Returns a Result, Modes for "modes" or a LinearModel
+        for "linear"."""
         kind = check_choice(analysis or self.analysis_type, "analysis", list(ANALYSES))
         settings = {**self.analysis, **{k: v for k, v in overrides.items() if v is not None}}
         kept = {k: v for k, v in settings.items()
@@ -153,9 +168,11 @@ class Scene:
             return simulate(self.model, progress=progress, **kept)
         if kind == "kinematic":
             return kinematics(self.model, progress=progress, **kept)
-        kept = {k: v for k, v in kept.items()
-                if k not in ANALYSIS_DEFAULTS and (k != "coordinates" or v != "auto")}
-        return (statics if kind == "static" else modes)(self.model, **kept)
+        kept = {k: v for k, v in kept.items() if k != "coordinates" or v != "auto"}
+        if kind == "quasi_static":
+            return quasi_statics(self.model, progress=progress, **kept)
+        kept = {k: v for k, v in kept.items() if k not in ANALYSIS_DEFAULTS}
+        return {"static": statics, "modes": modes, "linear": linearize}[kind](self.model, **kept)
 
     def columns(self, result: Result) -> Dict[str, np.ndarray]:
         """t and every output column of the scene, from a result."""
@@ -233,7 +250,7 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
         out["type"] = kind
     for key in ANALYSIS_OPTIONAL[1:]:
         if key in d and key not in ANALYSES[kind]:
-            takes = ", ".join(["t_end", "output_interval"] * (kind == "kinematic")
+            takes = ", ".join(["t_end", "output_interval"] * (kind in TIMED[1:])
                               + list(ANALYSES[kind]))
             fail(f"{where}.{key}", f"does not apply to a {kind} analysis, which takes {takes}; "
                  "leave it out")
@@ -252,10 +269,16 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                     fail(f"{where}.{key}", f"applies to {' and '.join(ADAPTIVE_OPTIONAL)}; "
                          f"{out['integrator']} chooses its steps itself (leave it out)")
                 out[key] = d[key]
-            elif key == "max_iterations":
-                if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < 1:
-                    fail(f"{where}.{key}", f"expected a positive integer, got {d[key]!r}")
+            elif key in ("max_iterations", "max_halvings"):
+                least = 1 if key == "max_iterations" else 0
+                if not isinstance(d[key], int) or isinstance(d[key], bool) or d[key] < least:
+                    fail(f"{where}.{key}", f"expected a whole number of at least {least}, "
+                         f"got {d[key]!r}")
                 out[key] = d[key]
+            elif key == "find_equilibrium":
+                out[key] = check_flag(d[key], f"{where}.{key}")
+            elif key in ("inputs", "outputs"):
+                out[key] = d[key]  # checked against the model (Scene.__init__)
             elif key == "coordinates":
                 out[key] = check_choice(d[key], f"{where}.{key}",
                                         COORDINATES if kind == "dynamic" else STATIC_COORDINATES)

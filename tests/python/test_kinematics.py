@@ -268,7 +268,7 @@ def test_a_scene_refuses_settings_its_analysis_does_not_take():
                        "kinematic analysis, which takes t_end, output_interval, max_iterations"):
         odyn.Scene(slider_crank(1.0), analysis={"type": "kinematic", "integrator": "dop853"})
     with pytest.raises(odyn.SceneError, match=r"analysis\.type: expected one of dynamic, "):
-        odyn.Scene(slider_crank(1.0), analysis={"type": "quasi-static"})
+        odyn.Scene(slider_crank(1.0), analysis={"type": "transient"})
     with pytest.raises(odyn.SceneError, match=r"analysis\.coordinates: expected one of "
                        "absolute, joint, got 'auto'"):
         odyn.Scene(slider_crank(1.0), analysis={"type": "static", "coordinates": "auto"})

@@ -129,3 +129,54 @@ def test_inputs_and_outputs_that_do_not_apply_are_refused_by_name():
         odyn.linearize(m, outputs=["left.length", ("left", "length")])
     with pytest.raises(odyn.SceneError, match="coordinates"):
         odyn.linearize(m, coordinates="minimal")
+
+
+def test_a_scene_names_a_linear_analysis_and_the_command_line_writes_its_matrices(tmp_path,
+                                                                                  capsys):
+    from odyn import cli
+    mass, k, c = 2.0, 50.0, 1.5
+    scene = odyn.Scene(oscillator(mass, k, c),
+                       analysis={"type": "linear", "find_equilibrium": True,
+                                 "inputs": {"push": {"body": "block", "force": [1.0, 0.0]}},
+                                 "outputs": ["centre.position.x", "left.length"]})
+    path = tmp_path / "oscillator.json"
+    odyn.save(scene, path)
+    assert odyn.load(path).analysis == scene.analysis
+    matrices = tmp_path / "linear.npz"
+    assert cli.main(["run", str(path), "--out", str(matrices)]) == 0
+    printed = capsys.readouterr().out
+    assert "linear analysis about the equilibrium" in printed
+    assert "2 states (1 degree of freedom), 1 inputs (push), 2 outputs" in printed
+    found = np.load(matrices)
+    assert list(found["inputs"]) == ["push"] and list(found["states"]) == ["z1", "z1'"]
+    assert list(found["outputs"]) == ["centre.position.x", "left.length"]
+    s = 2j * math.pi * 1.3
+    transfer = found["c"] @ np.linalg.solve(s * np.eye(2) - found["a"], found["b"])
+    expected = 1.0 / (mass * s * s + 2 * c * s + 2 * k)
+    np.testing.assert_allclose(transfer[:, 0], [expected, expected], rtol=1e-9)
+    # The eigenvalues as a table: the natural frequency and damping ratio of m x'' + 2 c x' +
+    # 2 k x = 0, in absolute coordinates as in joint ones.
+    table_file = tmp_path / "eigenvalues.csv"
+    for coordinates in ("absolute", "joint"):
+        assert cli.main(["run", str(path), "--quiet", "--coordinates", coordinates,
+                         "--out", str(table_file)]) == 0
+        table = np.genfromtxt(table_file, delimiter=",", names=True)
+        wn, zeta = math.sqrt(2 * k / mass), c / math.sqrt(2 * k * mass)
+        np.testing.assert_allclose(table["natural_frequency"], [wn / (2 * math.pi)] * 2,
+                                   rtol=1e-9)
+        np.testing.assert_allclose(table["damping_ratio"], [zeta] * 2, rtol=1e-9)
+    assert cli.main(["check", str(path)]) == 0
+    assert ("analysis: linear about the equilibrium, in absolute coordinates; inputs: push; "
+            "outputs: centre.position.x, left.length") in capsys.readouterr().out
+    assert cli.main(["run", str(path), "--gif", str(tmp_path / "x.gif")]) == 1
+    assert "a linear analysis gives one configuration" in capsys.readouterr().err
+    # The inputs and outputs are checked against the model when the scene is made.
+    with pytest.raises(odyn.SceneError, match=r"analysis\.inputs\['push'\]\.body: "):
+        odyn.Scene(oscillator(mass, k, c),
+                   analysis={"type": "linear", "inputs": {"push": {"body": "crate",
+                                                                    "force": [1, 0]}}})
+    with pytest.raises(odyn.SceneError, match=r"analysis\.outputs\[1\]"):
+        odyn.Scene(oscillator(mass, k, c),
+                   analysis={"type": "linear", "outputs": ["left.length", "left.stretch"]})
+    with pytest.raises(odyn.SceneError, match=r"analysis\.inputs: does not apply to a dynamic"):
+        odyn.Scene(oscillator(mass, k, c), analysis={"inputs": {}})

@@ -192,15 +192,18 @@ def test_the_sparse_method_finds_the_dense_lowest_modes():
         odyn.modes(chain, coordinates="joint", method="sparse")
 
 
-def test_a_slowly_turned_crank_needs_the_virtual_work_torque():
-    """A slider-crank turned quasi-statically by its motor against a spring on the piston and
-    the bars' weight: at every angle the motor's torque is dV/dtheta, V the potential energy."""
-    r, rod, k, wall, free = 0.2, 0.5, 200.0, 1.0, 0.4
-    mass = {"crank": 1.0, "rod": 0.5, "piston": 2.0}
+CRANK, ROD, SPRING, WALL, FREE = 0.2, 0.5, 200.0, 1.0, 0.4
+MASSES = {"crank": 1.0, "rod": 0.5, "piston": 2.0}
+
+
+def turned_slider_crank():
+    """A slider-crank turned by its motor at 1 rad/s against a spring on the piston and the
+    bars' weight."""
+    r, rod = CRANK, ROD
     m = odyn.PlanarModel()
-    m.add_body(name="crank", mass=mass["crank"], inertia=0.01, position=[r / 2, 0])
-    m.add_body(name="rod", mass=mass["rod"], inertia=0.02, position=[r + rod / 2, 0])
-    m.add_body(name="piston", mass=mass["piston"], inertia=0.01, position=[r + rod, 0])
+    m.add_body(name="crank", mass=MASSES["crank"], inertia=0.01, position=[r / 2, 0])
+    m.add_body(name="rod", mass=MASSES["rod"], inertia=0.02, position=[r + rod / 2, 0])
+    m.add_body(name="piston", mass=MASSES["piston"], inertia=0.01, position=[r + rod, 0])
     m.add_revolute(name="main", body_a="ground", body_b="crank", on_b=odyn.frame([-r / 2, 0]))
     m.add_revolute(name="pin", body_a="crank", on_a=odyn.frame([r / 2, 0]), body_b="rod",
                    on_b=odyn.frame([-rod / 2, 0]))
@@ -208,21 +211,64 @@ def test_a_slowly_turned_crank_needs_the_virtual_work_torque():
     m.add_translational(name="cylinder", body_a="ground", on_a=odyn.frame([0, 0], [1, 0]),
                         body_b="piston", on_b=odyn.frame([0, 0], [1, 0]))
     m.add_tsda(name="spring", body_a="piston", point_a=[0, 0], body_b="ground",
-               point_b=[wall, 0], stiffness=k, damping=0.0, free_length=free)
+               point_b=[WALL, 0], stiffness=SPRING, damping=0.0, free_length=FREE)
     m.add_gravity(name="gravity", acceleration=[0, -G])
     m.add_revolute_driver(name="motor", joint="main", motion=odyn.constant_velocity(1.0))
+    return m
 
-    result = odyn.quasi_statics(m, t_end=3.0, output_interval=0.1, coordinates="joint")
-    theta = result.t
-    assert len(theta) == 31 and len(result.statics) == 31
+
+def virtual_work_torque(theta):
+    """The piston's position and the motor's torque dV/dtheta at crank angles theta, V the
+    spring's and the bars' potential energy."""
+    r, rod = CRANK, ROD
     root = np.sqrt(rod ** 2 - (r * np.sin(theta)) ** 2)
     x = r * np.cos(theta) + root
     slope = -r * np.sin(theta) - r ** 2 * np.sin(theta) * np.cos(theta) / root
-    expected = (-k * (wall - x - free) * slope
-                + G * (mass["crank"] + mass["rod"]) * (r / 2) * np.cos(theta))
+    torque = (-SPRING * (WALL - x - FREE) * slope
+              + G * (MASSES["crank"] + MASSES["rod"]) * (r / 2) * np.cos(theta))
+    return x, torque
+
+
+def test_a_slowly_turned_crank_needs_the_virtual_work_torque():
+    """Turned quasi-statically, the motor's torque is dV/dtheta at every angle."""
+    m = turned_slider_crank()
+    result = odyn.quasi_statics(m, t_end=3.0, output_interval=0.1, coordinates="joint")
+    theta = result.t
+    assert len(theta) == 31 and len(result.statics) == 31
+    x, expected = virtual_work_torque(theta)
     torque = result.reaction("motor").torque
     np.testing.assert_allclose(torque, expected, atol=1e-9 * np.abs(expected).max())
     np.testing.assert_allclose(result.body("piston").position[:, 0], x, atol=1e-12)
     assert all(row["force_residual"] < 1e-12 for row in result.statics)
     with pytest.raises(odyn.SceneError, match="max_halvings"):
         odyn.quasi_statics(m, max_halvings=-1)
+
+
+def test_a_scene_names_a_quasi_static_analysis_and_the_command_line_runs_it(tmp_path, capsys):
+    from odyn import cli
+    scene = odyn.Scene(turned_slider_crank(),
+                       analysis={"type": "quasi_static", "t_end": 3.0, "output_interval": 0.5,
+                                 "coordinates": "joint", "max_halvings": 4},
+                       outputs=[{"name": "torque", "reaction": "motor", "quantity": "torque"}])
+    path = tmp_path / "crank.json"
+    odyn.save(scene, path)
+    assert odyn.load(path).analysis == scene.analysis
+    out = tmp_path / "torque.csv"
+    assert cli.main(["run", str(path), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "quasi-static analysis, t_end = 3 s: 7 outputs" in printed
+    assert "force imbalance" in printed and "driver motor: largest effort" in printed
+    table = np.genfromtxt(out, delimiter=",", names=True)
+    expected = virtual_work_torque(table["t"])[1]
+    np.testing.assert_allclose(table["torque"], expected, atol=1e-9 * np.abs(expected).max())
+    assert cli.main(["run", str(path), "--integrator", "dop853"]) == 1
+    assert "--integrator: not a setting of a quasi_static analysis" in capsys.readouterr().err
+    assert cli.main(["check", str(path)]) == 0
+    assert "analysis: quasi-static, t_end 3 s, output every 0.5 s, in joint coordinates" in \
+        capsys.readouterr().out
+    with pytest.raises(odyn.SceneError, match=r"analysis\.max_halvings: expected a whole "
+                       "number of at least 0"):
+        odyn.Scene(turned_slider_crank(), analysis={"type": "quasi_static", "max_halvings": -1})
+    with pytest.raises(odyn.SceneError, match=r"analysis\.max_halvings: does not apply to a "
+                       "static analysis"):
+        odyn.Scene(turned_slider_crank(), analysis={"type": "static", "max_halvings": 2})
