@@ -4,16 +4,23 @@
 #   bash scripts/setup.sh                 everything, the odyn Python package included
 #   bash scripts/setup.sh --no-package    the dependencies only (test.sh builds the package
 #                                         beside its C++ builds)
+#   bash scripts/setup.sh --tests ...     also what scripts/test.sh needs beyond that: clang, whose
+#                                         sanitizers build the test suite
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 package=1
-[[ ${1:-} == --no-package ]] && package=0
-
 packages=(
   build-essential cmake ninja-build ccache pkg-config git ca-certificates
   libeigen3-dev libsuitesparse-dev catch2 libbenchmark-dev
   python3 python3-venv python3-dev
 )
+for arg in "$@"; do
+  case $arg in
+    --no-package) package=0 ;;
+    --tests) packages+=(clang-15) ;;  # its ASan and UBSan runtimes come with it
+    *) echo "setup.sh: unknown option $arg (see the comment at its top)" >&2; exit 1 ;;
+  esac
+done
 
 # --- System packages -----------------------------------------------------------------------------
 missing=()

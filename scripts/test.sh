@@ -25,18 +25,19 @@ configure() {
 }
 
 section "Setup"
-bash scripts/setup.sh --no-package
+bash scripts/setup.sh --no-package --tests
 
 # Each test compiles once: the Catch2 suite in the sanitizer build, the examples (the C++ twins
 # of the Python tests) and the installed package's consumer in Release, and the Python package.
-# Template instantiation makes each translation unit cost tens of seconds of CPU, so the builds
-# run side by side. The longest chain is the sanitizer build (one unity unit: its files share
-# their models and integrators) and its test run; the rest builds beside it at a lower priority,
-# one unit at a time (the Python package, the examples, then the benchmarks that CI runs), so that
-# it fills the other core without slowing that chain. One at a time, because memory is the other
-# limit: the sanitizer unit alone peaks at 13.5 GB (20.3 GB before GCC was told to collect its
-# garbage more often, see CMakeLists.txt), each other unit 3 to 4 GB, and a machine that runs out
-# of memory does not fail, it crawls.
+# Template instantiation makes each translation unit cost minutes of CPU, so the builds run side
+# by side. The sanitizer build (one unity unit: its files share their models and integrators) is
+# Clang's: GCC 12 instantiates this library's templates several times slower, and more than
+# linearly in a unit's size (a third of its time goes to walking lists of type variants,
+# get_qualified_type), so that the unit took it over an hour. GCC 12 still compiles everything
+# else: the Python package, the examples, the downstream program and the benchmarks, which
+# instantiate every element and analysis. Those build beside the sanitizer build at a lower
+# priority, two units at a time; memory is the other limit (the Python package's spatial unit
+# peaks at 8.4 GB under GCC), and a machine that runs out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -50,7 +51,7 @@ finish() {
 section "Beside the sanitizer build: the Python package, the Release examples, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-(CMAKE_BUILD_PARALLEL_LEVEL=1 nice -n 10 bash scripts/setup.sh && echo "Built at $(stamp)") \
+(CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh && echo "Built at $(stamp)") \
   >"$python_log" 2>&1 &
 python_pid=$!
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
@@ -62,25 +63,32 @@ release_log=build/release.log
 (
   while kill -0 "$python_pid" 2>/dev/null; do sleep 5; done  # after the Python package's units
   echo "Release examples from $(stamp)"
-  nice -n 10 cmake --build build -j 1 --target engine slider_crank_planar four_bar andrews
+  nice -n 10 cmake --build build -j "$jobs" --target engine slider_crank_planar four_bar andrews
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   cmake -S tests/downstream -B build/downstream -G Ninja "${launcher[@]}" \
     -DCMAKE_PREFIX_PATH="$root/build/install"
-  nice -n 10 cmake --build build/downstream -j 1
+  nice -n 10 cmake --build build/downstream -j "$jobs"
   echo "Install + downstream find_package(odyn) at $(stamp):"
   ./build/downstream/odyn_downstream
-  # The benchmarks that CI runs briefly after this script: built here, on the core that the
-  # sanitizer build leaves free (it takes about 20 min longer than this chain), not after it.
+  # The benchmarks that CI runs briefly after this script: built here, beside the sanitizer
+  # tests, not after them.
   echo "Benchmarks from $(stamp)"
-  nice -n 10 cmake --build build -j 1 --target odyn_bench work_precision scaling
+  nice -n 10 cmake --build build -j "$jobs" --target odyn_bench work_precision scaling
   echo "Done at $(stamp)"
 ) >"$release_log" 2>&1 &
 release_pid=$!
 
-section "ASan + UBSan build of the tests (build-asan/)"
-# -Og -g1 (line tables: enough for sanitizer stack traces) compiles twice as fast as -O1 -g here.
-configure build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-Og -g1" -DODYN_SANITIZE=ON \
+section "ASan + UBSan build of the tests (build-asan/, Clang)"
+# A tree that another compiler configured starts afresh. Line tables are enough for sanitizer
+# stack traces.
+clang=clang++-15
+if [[ -f build-asan/CMakeCache.txt ]] && ! grep -q "^CMAKE_CXX_COMPILER:.*$clang" \
+    build-asan/CMakeCache.txt; then
+  rm -rf build-asan
+fi
+configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 

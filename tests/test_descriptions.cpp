@@ -17,6 +17,12 @@ namespace test_descriptions {
 
 /// A Reader (see description.hpp) that makes up a distinct value for each parameter from its key
 /// and the type asked for, and records what was read.
+/// A list of joints (a composite joint's parts). Checked as a concept, so that a type without
+/// value_type fails it instead of making the requirement ill-formed (Clang 15).
+template <class T>
+concept JointList = requires { typename T::value_type; } &&
+                    requires(typename T::value_type joint) { joint.on_a, joint.body_b; };
+
 class InventedValues {
  public:
   explicit InventedValues(const odyn::ElementDescription& description)
@@ -39,7 +45,7 @@ class InventedValues {
     } else if constexpr (std::is_same_v<T, odyn::JointCoordinateKind> ||
                          std::is_same_v<T, std::optional<odyn::JointCoordinateKind>>) {
       return odyn::JointCoordinateKind::angle;  // a coupler's coordinates
-    } else if constexpr (requires(typename T::value_type joint) { joint.on_a, joint.body_b; }) {
+    } else if constexpr (JointList<T>) {
       return typename T::value_type{odyn::BodyId{2}, {}, odyn::BodyId{3}, {}};  // joint_3
     } else if constexpr (std::is_same_v<T, odyn::BodyId>) {
       return odyn::BodyId{k == "body_b" || k == "piston" ? 2 : 1};
