@@ -120,9 +120,8 @@ def _output(model: BaseModel, given: Output, where: str) -> Dict[str, Any]:
                 "output": output}
     if len(parts) == 3:
         point, quantity, component = model._event_point(list(parts), where)
-        body, at = model._point_table()[point]
-        return {"name": f"{point}.{quantity}.{component}", "kind": "point", "body": body,
-                "at": at, "quantity": quantity, "component": "xyz".index(component)}
+        return {"name": f"{point}.{quantity}.{component}",
+                **model._point_reading(point, quantity, component)}
     fail(where, "expected an element's output ('spring.length') or a named point's position "
          f"or velocity ('tip.velocity.x'), got {given!r}")
     raise AssertionError  # fail() raises

@@ -345,6 +345,13 @@ class BaseModel:
                              + (f"; events: {', '.join(self._events)}" if self._events else ""))
         return dict(self._events[name])
 
+    def _point_reading(self, point: str, quantity: str, component: str) -> Dict[str, Any]:
+        """A named point's position or velocity component as the C++ side reads it: the body
+        by index, the point in its coordinates, the component by index."""
+        body, at = self._point_table()[point]
+        return {"kind": "point", "body": body, "at": at, "quantity": quantity,
+                "component": "xyz".index(component)}
+
     def _event_table(self) -> List[Dict[str, Any]]:
         """The events as the run takes them: points and bodies by index."""
         table = []
@@ -353,10 +360,7 @@ class BaseModel:
             if "output" in e:
                 row.update(kind="output", element=e["output"][0], output=e["output"][1])
             elif "point" in e:
-                point, quantity, component = e["point"]
-                body, at = self._point_table()[point]
-                row.update(kind="point", body=body, at=at, quantity=quantity,
-                           component="xyz".index(component))
+                row.update(self._point_reading(*e["point"]))
             else:
                 row.update(kind="function", function=e["function"],
                            bodies=[self._body_index[b] for b in e["bodies"]])
