@@ -74,7 +74,7 @@ release_log=build/release.log
   # The benchmarks that CI runs briefly after this script: built here, beside the sanitizer
   # tests, not after them.
   echo "Benchmarks from $(stamp)"
-  nice -n 10 cmake --build build -j "$jobs" --target odyn_bench work_precision scaling
+  nice -n 10 cmake --build build -j "$jobs" --target odyn_bench scaling
   echo "Done at $(stamp)"
 ) >"$release_log" 2>&1 &
 release_pid=$!
