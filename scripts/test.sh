@@ -71,10 +71,6 @@ release_log=build/release.log
   nice -n 10 cmake --build build/downstream -j "$jobs"
   echo "Install + downstream find_package(odyn) at $(stamp):"
   ./build/downstream/odyn_downstream
-  # The benchmarks that CI runs briefly after this script: built here, beside the sanitizer
-  # tests, not after them.
-  echo "Benchmarks from $(stamp)"
-  nice -n 10 cmake --build build -j "$jobs" --target odyn_bench scaling
   echo "Done at $(stamp)"
 ) >"$release_log" 2>&1 &
 release_pid=$!
