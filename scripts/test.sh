@@ -15,6 +15,10 @@ export CCACHE_BASEDIR=$root CCACHE_NOHASHDIR=true
 start=${ODYN_CI_START:-$(date +%s)}
 stamp() { echo "$(($(date +%s) - start)) s"; }
 section() { printf '\n===== %s (at %s) =====\n' "$*" "$(stamp)"; }
+# The builds beside the sanitizer build log to files, shown when they are waited for; their
+# milestones also go to the script's own stderr at once, so that a run cut short shows them.
+exec 3>&2
+milestone() { echo "$*" | tee -a /dev/fd/3; }  # -a: never truncate a log file behind fd 3
 
 # configure <build dir> <cmake args...>: Ninja for a new tree; an existing tree keeps its generator.
 configure() {
@@ -52,7 +56,8 @@ finish() {
 section "Beside the sanitizer build: the Python package, the Release engine, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-(CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh && echo "Built at $(stamp)") \
+(CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh &&
+  milestone "test.sh: the Python package and the engine's module built at $(stamp)") \
   >"$python_log" 2>&1 &
 python_pid=$!
 configure build -DCMAKE_BUILD_TYPE=Release -DODYN_SANITIZE=OFF \
@@ -63,7 +68,7 @@ cmake --install build --prefix build/install >/dev/null
 release_log=build/release.log
 (
   while kill -0 "$python_pid" 2>/dev/null; do sleep 5; done  # after the Python package's units
-  echo "Release engine example from $(stamp)"
+  milestone "test.sh: the Release engine example from $(stamp)"
   # The engine example, which the Python tests run; CI builds the other examples when its time
   # allows (.ci/run).
   nice -n 10 cmake --build build -j "$jobs" --target engine
@@ -74,7 +79,7 @@ release_log=build/release.log
   nice -n 10 cmake --build build/downstream -j "$jobs"
   echo "Install + downstream find_package(odyn) at $(stamp):"
   ./build/downstream/odyn_downstream
-  echo "Done at $(stamp)"
+  milestone "test.sh: the Release engine example and the downstream build done at $(stamp)"
 ) >"$release_log" 2>&1 &
 release_pid=$!
 
