@@ -15,14 +15,14 @@
 
 namespace test_descriptions {
 
-/// A Reader (see description.hpp) that makes up a distinct value for each parameter from its key
-/// and the type asked for, and records what was read.
 /// A list of joints (a composite joint's parts). Checked as a concept, so that a type without
 /// value_type fails it instead of making the requirement ill-formed (Clang 15).
 template <class T>
 concept JointList = requires { typename T::value_type; } &&
                     requires(typename T::value_type joint) { joint.on_a, joint.body_b; };
 
+/// A Reader (see description.hpp) that makes up a distinct value for each parameter from its key
+/// and the type asked for, and records what was read.
 class InventedValues {
  public:
   explicit InventedValues(const odyn::ElementDescription& description)
