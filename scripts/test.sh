@@ -39,8 +39,9 @@ bash scripts/setup.sh --no-package --tests
 # Clang's: GCC 12 instantiates this library's templates several times slower, and more than
 # linearly in a unit's size (a third of its time goes to walking lists of type variants,
 # get_qualified_type), so that the unit took it over an hour. GCC 12 still compiles everything
-# else: the Python package, the examples, the downstream program and the benchmarks, which
-# instantiate every element and analysis. Those build beside the sanitizer build at a lower
+# else: here the Python package and the engine's module, which instantiate every element and
+# analysis, the engine example and the downstream program (.ci/run adds the other examples and
+# the benchmarks when its time allows). Those build beside the sanitizer build at a lower
 # priority, two units at a time; memory is the other limit (the Python package's spatial unit
 # peaks at 8.4 GB under GCC), and a machine that runs out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
