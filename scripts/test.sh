@@ -84,6 +84,27 @@ release_log=build/release.log
 ) >"$release_log" 2>&1 &
 release_pid=$!
 
+# The Python tests (the twins of the C++ examples and of the downstream program) run as soon as
+# the builds above are done, beside the sanitizer build, which takes longer.
+py_dirs=()
+for d in python/tests tests/python; do
+  if [[ -d $d ]] && find "$d" -name 'test_*.py' -o -name '*_test.py' | grep -q .; then
+    py_dirs+=("$d")
+  fi
+done
+pytest_log=build/python-tests.log
+(
+  while kill -0 "$python_pid" 2>/dev/null || kill -0 "$release_pid" 2>/dev/null; do sleep 5; done
+  if ((${#py_dirs[@]})) && [[ -x .venv/bin/python ]]; then
+    milestone "test.sh: the Python tests from $(stamp)"
+    rc=0
+    .venv/bin/python -m pytest -q "${py_dirs[@]}" || rc=$?
+    if ((rc == 5)); then echo "pytest: no tests collected"; elif ((rc != 0)); then exit "$rc"; fi
+    milestone "test.sh: the Python tests done at $(stamp)"
+  fi
+) >"$pytest_log" 2>&1 &
+pytest_pid=$!
+
 section "ASan + UBSan build of the tests (build-asan/, Clang)"
 # A tree that another compiler configured starts afresh. Line tables are enough for sanitizer
 # stack traces.
@@ -122,18 +143,7 @@ finish "$release_pid" "$release_log" "the Release engine example or the downstre
 section "Python package"
 finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
 
-# Python tests: the twins of the C++ examples and of the downstream program need the above.
-py_dirs=()
-for d in python/tests tests/python; do
-  if [[ -d $d ]] && find "$d" -name 'test_*.py' -o -name '*_test.py' | grep -q .; then
-    py_dirs+=("$d")
-  fi
-done
-if ((${#py_dirs[@]})) && [[ -x .venv/bin/python ]]; then
-  section "Python tests"
-  rc=0
-  .venv/bin/python -m pytest -q "${py_dirs[@]}" || rc=$?
-  if ((rc == 5)); then echo "pytest: no tests collected"; elif ((rc != 0)); then exit "$rc"; fi
-fi
+section "Python tests"
+finish "$pytest_pid" "$pytest_log" "the Python tests"
 
 section "All checks passed"

@@ -12,7 +12,7 @@
 namespace hinge_chain {
 
 namespace sp = odyn::spatial;
-using Model = sp::Model<sp::Revolute, sp::Gravity, sp::Tsda>;
+using Model = sp::DefaultModel;
 
 inline Model build(int links, double tilt = 0.0) {
   using Eigen::Vector3d;

@@ -13,7 +13,7 @@
 namespace rope_model {
 
 namespace sp = odyn::spatial;
-using Model = sp::Model<sp::Spherical, sp::Gravity, sp::Tsda>;
+using Model = sp::DefaultModel;
 
 inline Model rope(int links, double speed = 0.0,
                   std::optional<sp::Tsda::Parameters> spring = std::nullopt, double offset = 0.0) {

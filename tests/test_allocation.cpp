@@ -17,7 +17,16 @@ std::atomic<long> allocations{0};
 std::atomic<bool> counting{false};
 }  // namespace test_allocation
 
-#ifdef __SANITIZE_ADDRESS__
+// GCC says __SANITIZE_ADDRESS__; Clang before 17 only answers __has_feature.
+#if defined(__SANITIZE_ADDRESS__)
+#define ODYN_TEST_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ODYN_TEST_UNDER_ASAN 1
+#endif
+#endif
+
+#ifdef ODYN_TEST_UNDER_ASAN
 // From <sanitizer/allocator_interface.h>, which GCC does not ship; libasan defines it.
 using MallocHook = void (*)(const volatile void*, std::size_t);
 using FreeHook = void (*)(const volatile void*);

@@ -54,7 +54,7 @@ double andrews_error(double tolerance, odyn::RunSummary* summary = nullptr) {
 }
 
 namespace pl = odyn::planar;
-using StiffModel = pl::Model<pl::Translational, pl::Tsda, pl::PointForce>;
+using StiffModel = pl::DefaultModel;
 
 /// A 1 kg slider on a spring-damper of k = 1e8 N/m (omega = 1e4 rad/s, damping ratio 0.8)
 /// loaded by F0 (1 - cos t), from rest: m x'' + c x' + k x = F0 (1 - cos t). The closed form:
@@ -107,7 +107,7 @@ double stiff_run(const std::string& integrator, double tolerance, odyn::RunSumma
 /// largest error of omega over three periods, relative to the spin, against the closed form.
 double torque_free_error(double tolerance, odyn::RunSummary& summary) {
   namespace sp = odyn::spatial;
-  using Model = sp::Model<sp::Fixed>;
+  using Model = sp::DefaultModel;
   const torque_free::Body exact;
   Model model;
   sp::Body brick{.name = "brick", .mass = 1.0, .inertia = sp::Body::principal(1.0, 2.0, 3.0)};

@@ -50,7 +50,7 @@ odyn::DynamicsSettings joint_settings(const char* integrator, double tolerance) 
 /// Four bodies in an open chain: a bar on a revolute joint to the ground, a second bar on a
 /// universal joint to it, a sleeve on a cylindrical joint along the second bar and a block
 /// welded to the first bar; gravity only. Started tilted and moving, so that every joint works.
-using ChainModel = sp::Model<sp::Revolute, sp::Universal, sp::Cylindrical, sp::Fixed, sp::Gravity>;
+using ChainModel = sp::DefaultModel;
 
 ChainModel chain() {
   ChainModel model;
@@ -421,7 +421,7 @@ TEST_CASE("Joint coordinates: a free root closed by a distance (the conical pend
   // at the angle theta from the vertical turns at Omega = sqrt(g / (L cos theta)). The rod acts
   // through the centre, so the body does not turn. The body is a free root (6 rates) and the
   // distance its only equation.
-  using Model = sp::Model<sp::Distance, sp::Gravity>;
+  using Model = sp::DefaultModel;
   const double g = 9.81, length = 1.0, theta = 0.5;
   const double radius = length * std::sin(theta), height = -length * std::cos(theta);
   const double rate = std::sqrt(g / (length * std::cos(theta)));

@@ -20,7 +20,7 @@ namespace test_pendulums {
 namespace {
 
 namespace sp = odyn::spatial;
-using Model = sp::Model<sp::Revolute, sp::Spherical, sp::Fixed, sp::Gravity>;
+using Model = sp::DefaultModel;
 using Workspace = odyn::Workspace<Model>;
 using Eigen::Matrix3d;
 using Eigen::Quaterniond;

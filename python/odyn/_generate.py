@@ -241,9 +241,17 @@ def elements_markdown() -> str:
         "",
         "`SpatialModelWith<...>` holds odyn's whole catalogue and the given types; "
         "`SpatialModelOf<...>` (and the planar twins) holds just the given types (and the "
-        "elements written in Python). The integrators' instantiations dominate the build either "
-        "way: the engine's module of two small models compiles in 680 s of CPU here (two "
-        "units, 440 s on two cores), odyn._core's three units in about 1200 s.",
+        "elements written in Python). The analyses' instantiations dominate the build either "
+        "way (minutes of CPU each with GCC 12; docs/benchmarks.md, \"Compile time\"). "
+        "`bind_models` compiles all of them; a module may instead call "
+        "`odyn::python::use_odyn_errors()` and `bind_model_types<Spatial, Planar>(m)`, then "
+        "bind for each model type only the analyses it is run with "
+        "(`include/odyn/python/analyses.hpp`): `bind_dynamics` (assembly and the dynamic "
+        "analysis, every integrator in both coordinates), `bind_kinematics` (the kinematic "
+        "analysis and the model report) and `bind_statics` (static equilibrium, quasi-statics, "
+        "modes and linearization, which cost GCC about as much as the dynamics). "
+        "`examples/python/odyn_engine/` binds the first two, in two units that two cores "
+        "compile side by side; odyn refuses the others on its models by name.",
         "",
         "The odyn package carries its C++ headers and CMake package, so the module builds "
         "against it as `examples/python/odyn_engine/` does: a `CMakeLists.txt` with "

@@ -7,6 +7,7 @@ from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
 
+from . import modules
 from ._schema import check_number, fail
 from .model import BaseModel
 from .results import Result, finished_run
@@ -47,7 +48,7 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
                 "tolerance": check_number(tolerance, "tolerance", positive=True),
                 "max_iterations": _whole(max_iterations, "max_iterations", 1),
                 "max_halvings": _whole(max_halvings, "max_halvings", 0)}
-    data = model.module.kinematics(model._core, settings, progress)
+    data = modules.analysis(model.module, "kinematics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)
 
@@ -136,7 +137,7 @@ def check(model: BaseModel, *, tolerance: float = 1e-12, max_iterations: int = 5
     equations and the joints that over-constrain, the drivers, and what the assembly did (the
     bodies it moved, the given velocity components it kept or changed). `print(report)` gives
     it as text. Raises odyn.AssemblyError if the model does not assemble."""
-    data = model.module.check(model._core, {
+    data = modules.analysis(model.module, "check")(model._core, {
         "assembly_tolerance": check_number(tolerance, "tolerance", positive=True),
         "assembly_max_iterations": _whole(max_iterations, "max_iterations", 1)})
     data["summary"] = None

@@ -7,7 +7,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _schema
+from . import _schema, modules
 from ._schema import check_choice, check_flag, check_vector, fail
 from .model import BaseModel
 from .results import Result
@@ -168,6 +168,6 @@ def linearize(model: BaseModel, *, inputs: Optional[Mapping[str, Mapping[str, An
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")
     settings["inputs"] = check_inputs(model, {} if inputs is None else inputs)
     settings["outputs"] = check_outputs(model, outputs)
-    data = model.module.linearize(model._core, settings)
+    data = modules.analysis(model.module, "linearize")(model._core, settings)
     found = data.pop("linear_model")
     return LinearModel(found, _result(model, data))

@@ -20,8 +20,31 @@ from ._schema import fail
 #: What a module of models must have (bind_models gives all of it).
 REQUIRED = ("Model", "PlanarModel", "element_types", "planar_element_types",
             "element_catalogue", "planar_element_catalogue", "joint_kinds",
-            "planar_joint_kinds", "assemble", "simulate", "statics", "modes", "kinematics",
-            "check", "quasi_statics", "linearize")
+            "planar_joint_kinds", "assemble", "simulate")
+
+#: The analyses a module may leave out, each with the C++ function that binds it
+#: (include/odyn/python/analyses.hpp) and what it is.
+OPTIONAL_ANALYSES = {
+    "kinematics": ("bind_kinematics", "the kinematic analysis (odyn.kinematics)"),
+    "check": ("bind_kinematics", "the model report (odyn.check)"),
+    "statics": ("bind_statics", "the static analysis (odyn.statics)"),
+    "quasi_statics": ("bind_statics", "the quasi-static analysis (odyn.quasi_statics)"),
+    "modes": ("bind_statics", "the modal analysis (odyn.modes)"),
+    "linearize": ("bind_statics", "the linearization (odyn.linearize)"),
+}
+
+
+def analysis(module: ModuleType, name: str) -> Any:
+    """The function of `module` that runs the analysis `name` (a key of OPTIONAL_ANALYSES);
+    a clear error if the module does not compile it."""
+    function = getattr(module, name, None)
+    if function is None:
+        binder, what = OPTIONAL_ANALYSES[name]
+        fail(f"module {module.__name__}",
+             f"it does not compile {what}: its C++ source binds only some analyses; add "
+             f"odyn::python::analysis::{binder} (or bind, every analysis) for its model types "
+             "and rebuild it (docs/elements.md, 'A module of your own')")
+    return function
 
 _registered: Dict[str, ModuleType] = {"odyn._core": _core}
 

@@ -7,6 +7,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from . import modules
 from ._schema import check_choice, check_flag, check_number, fail
 from .model import BaseModel
 from .results import Result, finished_run
@@ -61,7 +62,7 @@ def statics(model: BaseModel, *, coordinates: str = "absolute", tolerance: float
     squared frequencies)."""
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
                                 max_load_steps, relaxation, method)
-    return _result(model, model.module.statics(model._core, settings))
+    return _result(model, modules.analysis(model.module, "statics")(model._core, settings))
 
 
 def quasi_statics(model: BaseModel, *, t_end: float = 1.0, output_interval: float = 1e-2,
@@ -89,7 +90,7 @@ def quasi_statics(model: BaseModel, *, t_end: float = 1.0, output_interval: floa
     settings.update(t_end=t_end, max_halvings=max_halvings,
                     output_interval=check_number(output_interval, "output_interval",
                                                  positive=True))
-    data = model.module.quasi_statics(model._core, settings, progress)
+    data = modules.analysis(model.module, "quasi_statics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)
 
@@ -231,6 +232,6 @@ def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: 
                                 max_load_steps, relaxation, method)
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")
     settings["count"] = count
-    data = model.module.modes(model._core, settings)
+    data = modules.analysis(model.module, "modes")(model._core, settings)
     found = data.pop("modes")
     return Modes(found, _result(model, data), model)

@@ -1,4 +1,5 @@
-// odyn._core: the analyses of the spatial model, and the integrators the library knows by name.
+// odyn._core: the spatial model's analyses other than the dynamic one (dynamics.cpp), and the
+// integrators the library knows by name.
 
 #include <odyn/python/analyses.hpp>
 
@@ -7,7 +8,8 @@
 namespace odyn::python {
 
 void bind_spatial_analyses(py::module_& m) {
-  analysis::bind<SpatialBox>(m);
+  analysis::bind_kinematics<SpatialBox>(m);
+  analysis::bind_statics<SpatialBox>(m);
 }
 
 void bind_integrators(py::module_& m) {

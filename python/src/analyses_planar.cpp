@@ -1,5 +1,4 @@
-// odyn._core: the analyses of the planar model (a unit of its own: the two models' integrators
-// compile in parallel).
+// odyn._core: the planar model's analyses other than the dynamic one (dynamics_planar.cpp).
 
 #include <odyn/python/analyses.hpp>
 
@@ -8,7 +7,8 @@
 namespace odyn::python {
 
 void bind_planar_analyses(py::module_& m) {
-  analysis::bind<PlanarBox>(m);
+  analysis::bind_kinematics<PlanarBox>(m);
+  analysis::bind_statics<PlanarBox>(m);
 }
 
 }  // namespace odyn::python

@@ -13,8 +13,12 @@ using PlanarModel = PlanarModelWith<>;
 using SpatialBox = ModelBox<Model>;
 using PlanarBox = ModelBox<PlanarModel>;
 
-/// Registers the analyses (assembly, dynamics) of each model on the module (analyses.cpp,
-/// analyses_planar.cpp: the two models' integrators compile in parallel).
+/// Register each model's analyses on the module, in four units that compile in parallel: assembly
+/// and the dynamic analysis (dynamics.cpp, dynamics_planar.cpp) and the others (analyses.cpp,
+/// analyses_planar.cpp). GCC's time for a unit grows faster than its size, so smaller units also
+/// cost less in all.
+void bind_spatial_dynamics(py::module_& m);
+void bind_planar_dynamics(py::module_& m);
 void bind_spatial_analyses(py::module_& m);
 void bind_planar_analyses(py::module_& m);
 /// Registers `integrators`, the integrators the library knows by name (analyses.cpp).

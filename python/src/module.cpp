@@ -17,6 +17,8 @@ PYBIND11_MODULE(_core, m) {
   bind_integrators(m);
   m.def("combined_body", &combined_body, py::arg("body"), py::arg("space"),
         "A body dict with parts, combined by odyn's Composite (odyn.composite).");
+  bind_spatial_dynamics(m);
+  bind_planar_dynamics(m);
   bind_spatial_analyses(m);
   bind_planar_analyses(m);
 }

@@ -4,12 +4,19 @@ import csv
 import importlib.util
 import pathlib
 import shutil
+import signal
 import subprocess
 
 import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+# A shell without job control starts its background commands (`cmd &`, nohup, a CI runner, the
+# test command's own side builds) with SIGINT ignored, which Python and the CLI processes the
+# tests start would inherit: the tests of Ctrl-C need its default handler.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def python_example(name):

@@ -46,6 +46,24 @@ def test_odyns_own_model_sends_the_gas_force_to_its_module():
         m.add("engine_gas_force", name="gas", crank="crank", piston="piston")
 
 
+def test_an_analysis_the_module_does_not_compile_is_refused_by_name():
+    """odyn_engine binds the dynamic and kinematic analyses and the model report, not the
+    static ones; asking for one names the module, the analysis and the C++ call that adds it."""
+    spatial, planar = odyn.Model(module=odyn_engine), odyn.PlanarModel(module=odyn_engine)
+    crank_and_piston(spatial)
+    planar.add_body(name="crank", mass=1.4, inertia=1.5)
+    for model in (spatial, planar):
+        for run, what, binder in (
+                (odyn.statics, r"the static analysis \(odyn\.statics\)", "bind_statics"),
+                (odyn.modes, r"the modal analysis \(odyn\.modes\)", "bind_statics")):
+            with pytest.raises(odyn.SceneError,
+                               match=r"module odyn_engine: it does not compile " + what +
+                               r": .*odyn::python::analysis::" + binder):
+                run(model)
+        odyn.check(model)  # what it compiles runs
+        assert len(odyn.simulate(model, t_end=0.01, output_interval=0.01).t) == 2
+
+
 def test_a_type_the_module_does_not_compile_is_refused_by_name():
     m = odyn.Model(module=odyn_engine)
     crank_and_piston(m)

@@ -20,7 +20,8 @@ using Planar = odyn::python::PlanarModelOf<pl::Revolute, pl::Translational, pl::
                                            pl::PointForce, pl::PointTorque, pl::Tsda,
                                            engine::planar::GasForce>;
 
-/// Registers the planar model's analyses (planar_analyses.cpp).
+/// Registers the planar model's analyses, those odyn_engine.cpp binds for the spatial one
+/// (planar_analyses.cpp).
 void bind_planar_analyses(pybind11::module_& m);
 
 }  // namespace engine_module

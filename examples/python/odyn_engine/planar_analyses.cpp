@@ -5,5 +5,7 @@
 #include "engine_models.hpp"
 
 void engine_module::bind_planar_analyses(pybind11::module_& m) {
-  odyn::python::analysis::bind<odyn::python::ModelBox<Planar>>(m);
+  using PlanarBox = odyn::python::ModelBox<Planar>;
+  odyn::python::analysis::bind_dynamics<PlanarBox>(m);
+  odyn::python::analysis::bind_kinematics<PlanarBox>(m);
 }

@@ -1,7 +1,7 @@
 #pragma once
 // Assembly, dynamic, kinematic, static and modal analysis and the model report from Python, for
-// any model type of a module (odyn._core compiles its two models' in python/src/analyses.cpp and
-// analyses_planar.cpp). A run releases the GIL; at every output time it records the state, the
+// any model type of a module (odyn._core compiles its two models' in python/src/dynamics*.cpp and
+// analyses*.cpp). A run releases the GIL; at every output time it records the state, the
 // energies, the residuals, every constraint's reactions, every stateful force's state and every
 // element's outputs (core/outputs.hpp), then briefly takes the GIL to let Python handle signals
 // (Ctrl-C) and report progress. A run that stops early keeps what it recorded.
@@ -755,10 +755,36 @@ py::dict check(Box& box, const py::dict& settings) {
   return out;
 }
 
-/// Registers assemble, simulate, kinematics, check, statics, modes and linearize for one model
-/// type (pybind11 overloads by the model).
+/// Registers the dynamic analysis (simulate: every integrator, in both coordinates) and assembly
+/// for one model type (pybind11 overloads by the model). The largest share of a module's build:
+/// a module may compile it in a unit of its own.
 template <class Box>
-void bind(py::module_& m) {
+void bind_dynamics(py::module_& m) {
+  m.def("assemble", &assemble<Box>, py::arg("model"), py::arg("settings"),
+        "Assembles the model; returns its consistent initial state as one output row.");
+  m.def("simulate", &simulate<Box>, py::arg("model"), py::arg("settings"),
+        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
+        "Runs a dynamic analysis; returns the recorded outputs, the summary (None if the run "
+        "stopped early) and the exception that stopped it (None if it finished).");
+}
+
+/// Registers the kinematic analysis and the model report (kinematics, check) for one model type.
+template <class Box>
+void bind_kinematics(py::module_& m) {
+  m.def("kinematics", &kinematics<Box>, py::arg("model"), py::arg("settings"),
+        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
+        "Runs a kinematic analysis; returns the recorded outputs, the summary (None if it "
+        "stopped early) and the exception that stopped it (None if it finished).");
+  m.def("check", &check<Box>, py::arg("model"), py::arg("settings"),
+        "Assembles the model and reports its mobility; returns the assembled state as one "
+        "output row, with the assembly's report and the mobility.");
+}
+
+/// Registers the analyses built on static equilibrium for one model type: statics,
+/// quasi_statics, modes and linearize. With GCC they cost about as much to compile as the
+/// dynamic analysis; a module of one's own that needs none of them leaves them out.
+template <class Box>
+void bind_statics(py::module_& m) {
   m.def("statics", &statics<Box>, py::arg("model"), py::arg("settings"),
         "Finds the static equilibrium; returns it as one output row, with its summary.");
   m.def("modes", &modes<Box>, py::arg("model"), py::arg("settings"),
@@ -767,23 +793,18 @@ void bind(py::module_& m) {
   m.def("linearize", &linearize<Box>, py::arg("model"), py::arg("settings"),
         "Linearizes about the model's state or its equilibrium for the given inputs and "
         "outputs; returns the state as one output row, with the state-space model.");
-  m.def("kinematics", &kinematics<Box>, py::arg("model"), py::arg("settings"),
-        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
-        "Runs a kinematic analysis; returns the recorded outputs, the summary (None if it "
-        "stopped early) and the exception that stopped it (None if it finished).");
   m.def("quasi_statics", &quasi_statics<Box>, py::arg("model"), py::arg("settings"),
         py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
         "Runs a quasi-static analysis; returns the recorded equilibria, each one's summary and "
         "the exception that stopped it (None if it finished).");
-  m.def("check", &check<Box>, py::arg("model"), py::arg("settings"),
-        "Assembles the model and reports its mobility; returns the assembled state as one "
-        "output row, with the assembly's report and the mobility.");
-  m.def("assemble", &assemble<Box>, py::arg("model"), py::arg("settings"),
-        "Assembles the model; returns its consistent initial state as one output row.");
-  m.def("simulate", &simulate<Box>, py::arg("model"), py::arg("settings"),
-        py::arg("progress") = py::none(), py::arg("progress_interval") = 0.2,
-        "Runs a dynamic analysis; returns the recorded outputs, the summary (None if the run "
-        "stopped early) and the exception that stopped it (None if it finished).");
+}
+
+/// Registers every analysis for one model type: bind_dynamics, bind_kinematics and bind_statics.
+template <class Box>
+void bind(py::module_& m) {
+  bind_dynamics<Box>(m);
+  bind_kinematics<Box>(m);
+  bind_statics<Box>(m);
 }
 
 }  // namespace analysis
