@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Full check: ASan/UBSan build + Catch2 tests (allocation count included), the Release engine
-# example, install + downstream consumer, the Python package and its tests. Exits non-zero on the
-# first failure.
+# example, install + downstream consumer, the Python package and its tests. Exits non-zero on a
+# failure.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=$PWD
@@ -38,12 +38,16 @@ bash scripts/setup.sh --no-package --tests
 # by side. The sanitizer build (one unity unit: its files share their models and integrators) is
 # Clang's: GCC 12 instantiates this library's templates several times slower, and more than
 # linearly in a unit's size (a third of its time goes to walking lists of type variants,
-# get_qualified_type), so that the unit took it over an hour. GCC 12 still compiles everything
-# else: here the Python package and the engine's module, which instantiate every element and
-# analysis, the engine example and the downstream program (.ci/run adds the other examples and
-# the benchmarks when its time allows). Those build beside the sanitizer build at a lower
-# priority, two units at a time; memory is the other limit (the Python package's spatial unit
-# peaks at 8.4 GB under GCC), and a machine that runs out of memory does not fail, it crawls.
+# get_qualified_type), so that the unit took it over an hour. The Python package and the engine's
+# module, which instantiate every element and analysis, are Clang's too (ODYN_PACKAGE_CXX): it
+# built one of their units in 306 s of CPU where GCC 12 took over 850. GCC 12 compiles the engine
+# example and the downstream program (.ci/run adds the other examples and the benchmarks, the
+# analyses' included, when its time allows). Those builds run beside the sanitizer build at a
+# lower priority, two units at a time, and the Python tests as soon as they are built: the
+# sanitizer unit, Clang's back end at -O1 on the code of 20-odd model types, is the longest path
+# (docs/benchmarks.md, "Compile time"). Memory is the other limit (the sanitizer unit peaks near
+# 9 GB, a package unit near 3 GB), and a machine that runs out of memory does not fail, it
+# crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -57,7 +61,7 @@ finish() {
 section "Beside the sanitizer build: the Python package, the Release engine, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-(CMAKE_BUILD_PARALLEL_LEVEL=$jobs nice -n 10 bash scripts/setup.sh &&
+(CMAKE_BUILD_PARALLEL_LEVEL=$jobs ODYN_PACKAGE_CXX=clang++-15 nice -n 10 bash scripts/setup.sh &&
   milestone "test.sh: the Python package and the engine's module built at $(stamp)") \
   >"$python_log" 2>&1 &
 python_pid=$!
@@ -107,14 +111,14 @@ pytest_pid=$!
 
 section "ASan + UBSan build of the tests (build-asan/, Clang)"
 # A tree that another compiler configured starts afresh. Line tables are enough for sanitizer
-# stack traces.
+# stack traces. FastISel, -O0's instruction selector, cut a test file's compile by 8% at -O1.
 clang=clang++-15
 if [[ -f build-asan/CMakeCache.txt ]] && ! grep -q "^CMAKE_CXX_COMPILER:.*$clang" \
     build-asan/CMakeCache.txt; then
   rm -rf build-asan
 fi
 configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DODYN_SANITIZE=ON \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only -mllvm -fast-isel" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
 
