@@ -35,19 +35,19 @@ bash scripts/setup.sh --no-package --tests
 # twin of the Python tests) and the installed package's consumer in Release, and the Python
 # package.
 # Template instantiation makes each translation unit cost minutes of CPU, so the builds run side
-# by side. The sanitizer build (one unity unit: its files share their models and integrators) is
+# by side. The sanitizer build (two unity units, grouped by the models their files run) is
 # Clang's: GCC 12 instantiates this library's templates several times slower, and more than
 # linearly in a unit's size (a third of its time goes to walking lists of type variants,
-# get_qualified_type), so that the unit took it over an hour. The Python package and the engine's
-# module, which instantiate every element and analysis, are Clang's too (ODYN_PACKAGE_CXX): it
-# built one of their units in 306 s of CPU where GCC 12 took over 850. GCC 12 compiles the engine
-# example and the downstream program (.ci/run adds the other examples and the benchmarks, the
-# analyses' included, when its time allows). Those builds run beside the sanitizer build at a
-# lower priority, two units at a time, and the Python tests as soon as they are built: the
-# sanitizer unit, Clang's back end at -O1 on the code of 20-odd model types, is the longest path
-# (docs/benchmarks.md, "Compile time"). Memory is the other limit (the sanitizer unit peaks near
-# 9 GB, a package unit near 3 GB), and a machine that runs out of memory does not fail, it
-# crawls.
+# get_qualified_type), so that one unit of the tests took it over an hour. The Python package
+# and the engine's module, which instantiate every element and analysis, are Clang's too
+# (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took over 850.
+# GCC 12 compiles the engine example and the downstream program (.ci/run adds the other examples
+# and the benchmarks, the analyses' included, when its time allows). Those builds run beside the
+# sanitizer build at a lower priority, two units at a time, and the Python tests as soon as they
+# are built: the sanitizer units, Clang's back end at -O1 on the code of 20-odd model types, are
+# the longest path (docs/benchmarks.md, "Compile time"). Memory is the other limit (the
+# sanitizer build peaked near 9 GB as one unit, a package unit near 3 GB), and a machine that
+# runs out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
