@@ -42,12 +42,12 @@ bash scripts/setup.sh --no-package --tests
 # and the engine's module, which instantiate every element and analysis, are Clang's too
 # (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took over 850.
 # GCC 12 compiles the engine example and the downstream program (.ci/run adds the other examples
-# and the benchmarks, the analyses' included, when its time allows). Those builds run beside the
-# sanitizer build at a lower priority, two units at a time, and the Python tests as soon as they
-# are built: the sanitizer units, Clang's back end at -O1 on the code of 20-odd model types, are
-# the longest path (docs/benchmarks.md, "Compile time"). Memory is the other limit (the
-# sanitizer build peaked near 9 GB as one unit, a package unit near 3 GB), and a machine that
-# runs out of memory does not fail, it crawls.
+# and the benchmarks, the analyses' included, when its time allows). The sanitizer build's two
+# units take both cores first: Clang's back end at -O1 on the code of 20-odd model types is the
+# longest step (docs/benchmarks.md, "Compile time"). The other builds follow, two units at a time
+# at a lower priority beside the sanitizer runs, then the Python tests. Memory is what keeps them
+# apart: each sanitizer unit peaks near 9 GB, a package unit near 3 GB, and a machine that runs
+# out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -58,10 +58,15 @@ finish() {
   if ((rc != 0)); then echo "test.sh: $3 failed (exit $rc)" >&2; exit "$rc"; fi
 }
 
-section "Beside the sanitizer build: the Python package, the Release engine, the downstream build"
+section "After the sanitizer build: the Python package, the Release engine, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-(CMAKE_BUILD_PARALLEL_LEVEL=$jobs ODYN_PACKAGE_CXX=clang++-15 nice -n 10 bash scripts/setup.sh &&
+# They start once the sanitizer build is done: its two units peak near 9 GB each, and the
+# package's units beside them would need more memory than the 2-core machine's 24 GB.
+asan_built=build/.sanitizer-build-done
+rm -f "$asan_built"
+(while [[ ! -e $asan_built ]]; do sleep 5; done
+  CMAKE_BUILD_PARALLEL_LEVEL=$jobs ODYN_PACKAGE_CXX=clang++-15 nice -n 10 bash scripts/setup.sh &&
   milestone "test.sh: the Python package and the engine's module built at $(stamp)") \
   >"$python_log" 2>&1 &
 python_pid=$!
@@ -121,6 +126,7 @@ configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
   -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only -mllvm -fast-isel" -DODYN_SANITIZE=ON \
   -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 cmake --build build-asan -j "$jobs"
+touch "$asan_built"
 
 section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
 asan_rc=0
