@@ -60,7 +60,8 @@ def test_an_analysis_the_module_does_not_compile_is_refused_by_name():
                                match=r"module odyn_engine: it does not compile " + what +
                                r": .*odyn::python::analysis::" + binder):
                 run(model)
-        odyn.check(model)  # what it compiles runs
+        # What it compiles runs: free bodies, 6 (space) or 3 (plane) degrees of freedom each.
+        assert odyn.check(model).degrees_of_freedom == (12 if model is spatial else 3)
         assert len(odyn.simulate(model, t_end=0.01, output_interval=0.01).t) == 2
 
 
