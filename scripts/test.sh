@@ -2,10 +2,22 @@
 # Full check: ASan/UBSan build + Catch2 tests (allocation count included), the Release engine
 # example, install + downstream consumer, the Python package and its tests. Exits non-zero on a
 # failure.
+#   bash scripts/test.sh          all of that, except the long runs (tests/CMakeLists.txt)
+#   bash scripts/test.sh --long   then the long runs: odyn_tests_long, -O1 under ASan+UBSan
+#   bash scripts/test.sh --only-long   the long runs alone, after a run of the test command
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=$PWD
 jobs=$(nproc)
+long=0
+only_long=0
+for arg in "$@"; do
+  case $arg in
+    --long) long=1 ;;
+    --only-long) long=1 only_long=1 ;;
+    *) echo "test.sh: unknown option $arg (see the comment at its top)" >&2; exit 1 ;;
+  esac
+done
 
 # Let ccache hit across checkouts (CI builds in a fresh clone) and across build directories.
 export CCACHE_BASEDIR=$root CCACHE_NOHASHDIR=true
@@ -28,26 +40,81 @@ configure() {
   cmake -S . -B "$dir" "${gen[@]}" "$@"
 }
 
+# The sanitizer build's tree. A tree that another compiler configured starts afresh. Line tables
+# are enough for sanitizer stack traces. FastISel, -O0's instruction selector, cut a test file's
+# compile by 8% at -O1 (the long runs' flags); the other files are compiled at -O0.
+configure_sanitizer_build() {
+  local clang=clang++-15
+  if [[ -f build-asan/CMakeCache.txt ]] && ! grep -q "^CMAKE_CXX_COMPILER:.*$clang" \
+      build-asan/CMakeCache.txt; then
+    rm -rf build-asan
+  fi
+  configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
+    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only -mllvm -fast-isel" -DODYN_SANITIZE=ON \
+    -DODYN_TEST_UNOPTIMIZED_FLAGS=-O0 \
+    -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
+}
+
+# run_sanitizer_tests <ctest args...>: the sanitizer build's tests with ctest; names the slowest
+# cases and repeats the failures last.
+run_sanitizer_tests() {
+  local rc=0
+  (
+    export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+    export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" "$@"  # the suite in shares
+  ) || rc=$?
+  # The sanitizer run is the longest step of CI: name the cases that cost it most.
+  echo "Slowest cases under the sanitizers (seconds):"
+  grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log | sort -rn | head -n 12 ||
+    true
+  if ((rc != 0)); then
+    # The run's log (every case with its time) is long enough to be cut where CI shows only its
+    # ends: repeat the failures last, without the timings.
+    section "The sanitizer run's failures, again"
+    grep -vE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log |
+      grep -B 14 -A 16 -E 'FAILED:|ERROR: AddressSanitizer|runtime error:' | tail -n 200 || true
+    exit "$rc"
+  fi
+}
+
+# The long runs: their -O1 build takes both cores for half an hour or more.
+long_runs() {
+  section "The long runs: ASan + UBSan build at -O1 (build-asan/, odyn_tests_long)"
+  configure_sanitizer_build
+  cmake --build build-asan -j "$jobs" --target odyn_tests_long
+  section "The long runs under ASan + UBSan"
+  run_sanitizer_tests -L long
+}
+if ((only_long)); then
+  long_runs
+  section "The long runs passed"
+  exit 0
+fi
+
 section "Setup"
 bash scripts/setup.sh --no-package --tests
 
 # Each test compiles once: the Catch2 suite in the sanitizer build, the engine example (the C++
 # twin of the Python tests) and the installed package's consumer in Release, and the Python
 # package.
-# Template instantiation makes each translation unit cost minutes of CPU, so the builds run side
-# by side. The sanitizer build (two unity units, grouped by the models their files run) is
+# Template instantiation makes each translation unit cost minutes of CPU. The sanitizer build is
 # Clang's: GCC 12 instantiates this library's templates several times slower, and more than
 # linearly in a unit's size (a third of its time goes to walking lists of type variants,
-# get_qualified_type), so that one unit of the tests took it over an hour. The Python package
-# and the engine's module, which instantiate every element and analysis, are Clang's too
-# (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took over 850.
-# GCC 12 compiles the engine example and the downstream program (.ci/run adds the other examples
-# and the benchmarks, the analyses' included, when its time allows). The sanitizer build's two
-# units take both cores first: Clang's back end at -O1 on the code of 20-odd model types is the
-# longest step (docs/benchmarks.md, "Compile time"). The other builds follow, two units at a time
-# at a lower priority beside the sanitizer runs, then the Python tests. Memory is what keeps them
-# apart: each sanitizer unit peaks near 9 GB, a package unit near 3 GB, and a machine that runs
-# out of memory does not fail, it crawls.
+# get_qualified_type), so that one unit of the tests took it over an hour. Clang's back end at
+# -O1 pays for the volume instead: the whole suite took it over an hour, against 10 minutes at
+# -O0, where the suite runs about 10 times as long. So the test command compiles at -O0 the
+# files whose cases run in seconds to a minute even so (odyn_tests), and leaves out the long runs
+# (tests/CMakeLists.txt, ODYN_LONG_RUN_TESTS: their -O1 build alone takes both cores for over
+# half an hour); --long adds them, and .ci/run runs them when its time allows
+# (docs/benchmarks.md, "Compile time").
+# The Python package and the engine's module, which instantiate every element and analysis, are
+# Clang's too (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took
+# over 850. GCC 12 compiles the engine example and the downstream program (.ci/run adds the
+# other examples and the benchmarks, the analyses' included, when its time allows). They follow
+# the sanitizer build, two units at a time at a lower priority beside the sanitizer runs, then
+# the Python tests. Memory also keeps them apart: a unit of the tests peaks near 5 GB at -O0 and
+# near 9 GB at -O1, a package unit near 3 GB, and a machine out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -61,8 +128,7 @@ finish() {
 section "After the sanitizer build: the Python package, the Release engine, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-# They start once the sanitizer build is done: its two units peak near 9 GB each, and the
-# package's units beside them would need more memory than the 2-core machine's 24 GB.
+# They start once the sanitizer build is done, so as not to slow it: its units take both cores.
 asan_built=build/.sanitizer-build-done
 rm -f "$asan_built"
 (while [[ ! -e $asan_built ]]; do sleep 5; done
@@ -115,37 +181,12 @@ pytest_log=build/python-tests.log
 pytest_pid=$!
 
 section "ASan + UBSan build of the tests (build-asan/, Clang)"
-# A tree that another compiler configured starts afresh. Line tables are enough for sanitizer
-# stack traces. FastISel, -O0's instruction selector, cut a test file's compile by 8% at -O1.
-clang=clang++-15
-if [[ -f build-asan/CMakeCache.txt ]] && ! grep -q "^CMAKE_CXX_COMPILER:.*$clang" \
-    build-asan/CMakeCache.txt; then
-  rm -rf build-asan
-fi
-configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only -mllvm -fast-isel" -DODYN_SANITIZE=ON \
-  -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
-cmake --build build-asan -j "$jobs"
+configure_sanitizer_build
+cmake --build build-asan -j "$jobs" --target odyn_tests
 touch "$asan_built"
 
-section "ASan + UBSan tests (the Catch2 suite, the allocation count included)"
-asan_rc=0
-(
-  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
-  export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-  ctest --test-dir build-asan --output-on-failure -j "$jobs"  # the suite in shares
-) || asan_rc=$?
-# The sanitizer run is the longest step of CI: name the cases that cost it most.
-echo "Slowest cases under the sanitizers (seconds):"
-grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log | sort -rn | head -n 12 || true
-if ((asan_rc != 0)); then
-  # The run's log (every case with its time) is long enough to be cut where CI shows only its
-  # ends: repeat the failures last, without the timings.
-  section "The sanitizer run's failures, again"
-  grep -vE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log |
-    grep -B 14 -A 16 -E 'FAILED:|ERROR: AddressSanitizer|runtime error:' | tail -n 200 || true
-  exit "$asan_rc"
-fi
+section "ASan + UBSan tests (the Catch2 suite but its long runs, the allocation count included)"
+run_sanitizer_tests -LE long
 
 section "Release engine example, install + downstream find_package(odyn)"
 finish "$release_pid" "$release_log" "the Release engine example or the downstream build"
@@ -155,5 +196,7 @@ finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
 
 section "Python tests"
 finish "$pytest_pid" "$pytest_log" "the Python tests"
+
+if ((long)); then long_runs; fi
 
 section "All checks passed"

@@ -72,15 +72,15 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
     peak_reaction = std::max(peak_reaction, std::abs(sample.R_z));
 
   // The same method in absolute and in joint coordinates (4 coordinates and the crank pin's 3
-  // closure equations instead of 18 and 17).
-  for (const char* coordinates : {"absolute", "joint"}) {
+  // closure equations instead of 18 and 17). Each by its type: the selection by name is
+  // test_step_control's and test_joint_coordinates'.
+  const auto run = [&]<template <class> class Integrator>(const char* coordinates) {
     auto e = engine::build();
     odyn::Workspace<engine::Model> ws(e.model);
     std::size_t k = 0;
     double z_error = 0.0, reaction_error = 0.0, velocity_residual = 0.0;
-    auto settings = adams(1e-4, 5);
-    settings.coordinates = coordinates;
-    const auto summary = odyn::simulate(e.model, ws, settings, [&](const auto& state) {
+    const auto settings = adams(1e-4, 5);
+    const auto summary = odyn::simulate_with<Integrator>(e.model, ws, settings, [&](const auto& state) {
       const auto& expected = reference.at(k++);
       z_error = std::max(z_error, std::abs(engine::piston_height(e, state) - expected.z_piston));
       // Away from the jumps of the gas force, where an output may sit on either side.
@@ -108,7 +108,9 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
     CHECK(summary.statistics.restarts == summary.statistics.events + 1);
     // About one factorization per step: the start-up steps after each restart take 7.
     CHECK(summary.statistics.factorizations < 1.4 * static_cast<double>(summary.statistics.steps));
-  }
+  };
+  run.operator()<odyn::AdamsBashforth>("absolute");
+  run.operator()<odyn::JointAdamsBashforth>("joint");
 
   SECTION("planar, order 4 and 6: the error falls with the order") {
     double errors[2] = {0.0, 0.0};
@@ -116,7 +118,8 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
     for (const int order : {4, 6}) {
       auto e = engine::planar::build();
       odyn::Workspace<engine::planar::Model> ws(e.model);
-      odyn::simulate(e.model, ws, adams(1e-4, order), [](const auto&) {});
+      odyn::simulate_with<odyn::AdamsBashforth>(e.model, ws, adams(1e-4, order),
+                                                [](const auto&) {});
       errors[i++] = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     }
     INFO("theta(1) errors " << errors[0] << " (order 4), " << errors[1] << " (order 6)");
@@ -133,7 +136,7 @@ TEST_CASE("adams: beyond the explicit stability limit, a clear error; bad settin
     auto settings = adams(2e-3, 4);
     settings.t_end = 1.0;
     try {
-      odyn::simulate(chain.model, ws, settings, [](const auto&) {});
+      odyn::simulate_with<odyn::AdamsBashforth>(chain.model, ws, settings, [](const auto&) {});
       FAIL("the run went through");
     } catch (const odyn::SolverError& error) {
       const std::string message = error.what();
@@ -144,7 +147,9 @@ TEST_CASE("adams: beyond the explicit stability limit, a clear error; bad settin
   }
   SECTION("orders outside 1 to 6") {
     for (const int order : {0, 7})
-      CHECK_THROWS_WITH(odyn::simulate(chain.model, ws, adams(1e-4, order), [](const auto&) {}),
+      CHECK_THROWS_WITH(odyn::simulate_with<odyn::AdamsBashforth>(chain.model, ws,
+                                                                  adams(1e-4, order),
+                                                                  [](const auto&) {}),
                         Catch::Contains("adams") && Catch::Contains("order"));
   }
 }
