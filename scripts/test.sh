@@ -111,10 +111,10 @@ bash scripts/setup.sh --no-package --tests
 # The Python package and the engine's module, which instantiate every element and analysis, are
 # Clang's too (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took
 # over 850. GCC 12 compiles the engine example and the downstream program (.ci/run adds the
-# other examples and the benchmarks, the analyses' included, when its time allows). They follow
-# the sanitizer build, two units at a time at a lower priority beside the sanitizer runs, then
-# the Python tests. Memory also keeps them apart: a unit of the tests peaks near 5 GB at -O0 and
-# near 9 GB at -O1, a package unit near 3 GB, and a machine out of memory does not fail, it crawls.
+# other examples and the benchmarks, the analyses' included, when its time allows). They run
+# beside the sanitizer build and runs at a lower priority, two units at a time, then the Python
+# tests. A unit of the tests peaks near 5 GB at -O0 and near 9 GB at -O1, a package unit near
+# 3 GB: a machine out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -125,14 +125,12 @@ finish() {
   if ((rc != 0)); then echo "test.sh: $3 failed (exit $rc)" >&2; exit "$rc"; fi
 }
 
-section "After the sanitizer build: the Python package, the Release engine, the downstream build"
+section "Beside the sanitizer build: the Python package, the Release engine, the downstream build"
 mkdir -p build
 python_log=build/python-package.log
-# They start once the sanitizer build is done, so as not to slow it: its units take both cores.
-asan_built=build/.sanitizer-build-done
-rm -f "$asan_built"
-(while [[ ! -e $asan_built ]]; do sleep 5; done
-  CMAKE_BUILD_PARALLEL_LEVEL=$jobs ODYN_PACKAGE_CXX=clang++-15 nice -n 10 bash scripts/setup.sh &&
+# At a lower priority, they take the cores the sanitizer build and runs leave idle (a unit that
+# ends before the others, a share of the tests that ends first).
+(CMAKE_BUILD_PARALLEL_LEVEL=$jobs ODYN_PACKAGE_CXX=clang++-15 nice -n 10 bash scripts/setup.sh &&
   milestone "test.sh: the Python package and the engine's module built at $(stamp)") \
   >"$python_log" 2>&1 &
 python_pid=$!
@@ -183,7 +181,6 @@ pytest_pid=$!
 section "ASan + UBSan build of the tests (build-asan/, Clang)"
 configure_sanitizer_build
 cmake --build build-asan -j "$jobs" --target odyn_tests
-touch "$asan_built"
 
 section "ASan + UBSan tests (the Catch2 suite but its long runs, the allocation count included)"
 run_sanitizer_tests -LE long
