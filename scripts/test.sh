@@ -66,8 +66,8 @@ run_sanitizer_tests() {
   ) || rc=$?
   # The sanitizer run is the longest step of CI: name the cases that cost it most.
   echo "Slowest cases under the sanitizers (seconds):"
-  grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log | sort -rn | head -n 12 ||
-    true
+  grep -hE '^[0-9]+\.[0-9]+ s: ' build-asan/Testing/Temporary/LastTest.log |
+    sort -rn | head -n 12 || true
   if ((rc != 0)); then
     # The run's log (every case with its time) is long enough to be cut where CI shows only its
     # ends: repeat the failures last, without the timings.

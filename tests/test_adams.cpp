@@ -80,17 +80,19 @@ TEST_CASE("adams: the engine against the minimal-coordinate reference at h = 1e-
     std::size_t k = 0;
     double z_error = 0.0, reaction_error = 0.0, velocity_residual = 0.0;
     const auto settings = adams(1e-4, 5);
-    const auto summary = odyn::simulate_with<Integrator>(e.model, ws, settings, [&](const auto& state) {
-      const auto& expected = reference.at(k++);
-      z_error = std::max(z_error, std::abs(engine::piston_height(e, state) - expected.z_piston));
-      // Away from the jumps of the gas force, where an output may sit on either side.
-      if (std::abs(engine::crank_angle(e, state) / std::numbers::pi -
-                   std::round(engine::crank_angle(e, state) / std::numbers::pi)) > 1e-3)
-        reaction_error =
-            std::max(reaction_error, std::abs(engine::bearing_force_z(e, state) - expected.R_z));
-      velocity_residual =
-          std::max(velocity_residual, odyn::constraint_residuals(e.model, state).second);
-    });
+    const auto summary =
+        odyn::simulate_with<Integrator>(e.model, ws, settings, [&](const auto& state) {
+          const auto& expected = reference.at(k++);
+          z_error =
+              std::max(z_error, std::abs(engine::piston_height(e, state) - expected.z_piston));
+          // Away from the jumps of the gas force, where an output may sit on either side.
+          if (std::abs(engine::crank_angle(e, state) / std::numbers::pi -
+                       std::round(engine::crank_angle(e, state) / std::numbers::pi)) > 1e-3)
+            reaction_error = std::max(reaction_error,
+                                      std::abs(engine::bearing_force_z(e, state) - expected.R_z));
+          velocity_residual =
+              std::max(velocity_residual, odyn::constraint_residuals(e.model, state).second);
+        });
     const double theta_error = std::abs(engine::crank_angle(e, ws) - reference.back().theta);
     INFO(coordinates << " coordinates: theta(1) error " << theta_error << ", z error " << z_error
                      << ", R_z error " << reaction_error / peak_reaction << " of the peak, |Phi| "
@@ -147,9 +149,8 @@ TEST_CASE("adams: beyond the explicit stability limit, a clear error; bad settin
   }
   SECTION("orders outside 1 to 6") {
     for (const int order : {0, 7})
-      CHECK_THROWS_WITH(odyn::simulate_with<odyn::AdamsBashforth>(chain.model, ws,
-                                                                  adams(1e-4, order),
-                                                                  [](const auto&) {}),
+      CHECK_THROWS_WITH(odyn::simulate_with<odyn::AdamsBashforth>(
+                            chain.model, ws, adams(1e-4, order), [](const auto&) {}),
                         Catch::Contains("adams") && Catch::Contains("order"));
   }
 }
