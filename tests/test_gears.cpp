@@ -36,7 +36,12 @@ constexpr double pi = std::numbers::pi;
 struct Random {
   std::mt19937 engine{20261129u};
   double uniform() { return 2.0 * (static_cast<double>(engine()) / 4294967296.0) - 1.0; }
-  Vector3d vector(double scale) { return scale * Vector3d(uniform(), uniform(), uniform()); }
+  // One draw per declarator: a call's arguments are evaluated in an order of the compiler's
+  // choosing (g++ and Clang differ), which would change the poses.
+  Vector3d vector(double scale) {
+    const double x = uniform(), y = uniform(), z = uniform();
+    return scale * Vector3d(x, y, z);
+  }
 };
 
 /// Bodies 1..3 at random poses and velocities (body 0: the ground).
@@ -48,7 +53,9 @@ struct Poses {
     q[0] << 0, 0, 0, 1, 0, 0, 0;
     v[0].setZero();
     for (int b = 1; b < 4; ++b) {
-      Eigen::Quaterniond r(random.uniform(), random.uniform(), random.uniform(), random.uniform());
+      const double w = random.uniform(), x = random.uniform(), y = random.uniform(),
+                   z = random.uniform();
+      Eigen::Quaterniond r(w, x, y, z);
       r.normalize();
       q[b] << random.vector(0.5), r.w(), r.x(), r.y(), r.z();
       v[b] << random.vector(1.0), random.vector(2.0);

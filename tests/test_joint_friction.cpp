@@ -63,13 +63,17 @@ std::vector<Vector2d> runge_kutta(const std::function<Vector2d(double, const Vec
 TEST_CASE("Joint friction's damping block is the derivative of its force", "[friction]") {
   std::mt19937 engine(20261129u);
   const auto uniform = [&] { return 2.0 * (static_cast<double>(engine()) / 4294967296.0) - 1.0; };
+  // One draw per declarator: a call's arguments are evaluated in an order of the compiler's
+  // choosing (g++ and Clang differ), which would change the poses.
   const auto vector = [&](double scale) {
-    return Vector3d(scale * Vector3d(uniform(), uniform(), uniform()));
+    const double x = uniform(), y = uniform(), z = uniform();
+    return Vector3d(scale * Vector3d(x, y, z));
   };
   std::array<Space::Frame, 2> frames;
   std::array<Space::Configuration, 2> q;
   for (auto& c : q) {
-    Eigen::Quaterniond r(uniform(), uniform(), uniform(), uniform());
+    const double w = uniform(), x = uniform(), y = uniform(), z = uniform();
+    Eigen::Quaterniond r(w, x, y, z);
     r.normalize();
     c << vector(0.5), r.w(), r.x(), r.y(), r.z();
   }

@@ -37,7 +37,12 @@ class Random {
  public:
   explicit Random(std::uint32_t seed) : engine_(seed) {}
   double uniform() { return 2.0 * (static_cast<double>(engine_()) / 4294967296.0) - 1.0; }
-  Vector2d vector(double scale) { return scale * Vector2d(uniform(), uniform()); }
+  // One draw per declarator: a call's arguments are evaluated in an order of the compiler's
+  // choosing (g++ and Clang differ), which would change the poses.
+  Vector2d vector(double scale) {
+    const double x = uniform(), y = uniform();
+    return scale * Vector2d(x, y);
+  }
 
  private:
   std::mt19937 engine_;
