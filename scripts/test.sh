@@ -2,22 +2,16 @@
 # Full check: ASan/UBSan build + Catch2 tests (allocation count included), the Release engine
 # example, install + downstream consumer, the Python package and its tests. Exits non-zero on a
 # failure.
-#   bash scripts/test.sh          all of that, except the long runs (tests/CMakeLists.txt)
-#   bash scripts/test.sh --long   then the long runs: odyn_tests_long, -O1 under ASan+UBSan
-#   bash scripts/test.sh --only-long   the long runs alone, after a run of the test command
+# The Catch2 suite's long runs (tests/CMakeLists.txt, ODYN_LONG_RUN_TESTS) are compiled at -O1
+# without the sanitizers, its other files at -O0 with them.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=$PWD
 jobs=$(nproc)
-long=0
-only_long=0
-for arg in "$@"; do
-  case $arg in
-    --long) long=1 ;;
-    --only-long) long=1 only_long=1 ;;
-    *) echo "test.sh: unknown option $arg (see the comment at its top)" >&2; exit 1 ;;
-  esac
-done
+if (($#)); then
+  echo "test.sh: no options (see the comment at its top)" >&2
+  exit 1
+fi
 
 # Let ccache hit across checkouts (CI builds in a fresh clone) and across build directories.
 export CCACHE_BASEDIR=$root CCACHE_NOHASHDIR=true
@@ -41,8 +35,8 @@ configure() {
 }
 
 # The sanitizer build's tree. A tree that another compiler configured starts afresh. Line tables
-# are enough for sanitizer stack traces. FastISel, -O0's instruction selector, cut a test file's
-# compile by 8% at -O1 (the long runs' flags); the other files are compiled at -O0.
+# are enough for sanitizer stack traces. -O1 is the long runs' level; the other files are
+# compiled at -O0.
 configure_sanitizer_build() {
   local clang=clang++-15
   if [[ -f build-asan/CMakeCache.txt ]] && ! grep -q "^CMAKE_CXX_COMPILER:.*$clang" \
@@ -50,7 +44,7 @@ configure_sanitizer_build() {
     rm -rf build-asan
   fi
   configure build-asan -DCMAKE_CXX_COMPILER="$clang" -DCMAKE_BUILD_TYPE=Debug \
-    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only -mllvm -fast-isel" -DODYN_SANITIZE=ON \
+    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DODYN_SANITIZE=ON \
     -DODYN_TEST_UNOPTIMIZED_FLAGS=-O0 \
     -DODYN_BUILD_TESTS=ON -DODYN_BUILD_EXAMPLES=OFF -DODYN_BUILD_BENCH=OFF
 }
@@ -78,20 +72,6 @@ run_sanitizer_tests() {
   fi
 }
 
-# The long runs: their -O1 build takes both cores for half an hour or more.
-long_runs() {
-  section "The long runs: ASan + UBSan build at -O1 (build-asan/, odyn_tests_long)"
-  configure_sanitizer_build
-  cmake --build build-asan -j "$jobs" --target odyn_tests_long
-  section "The long runs under ASan + UBSan"
-  run_sanitizer_tests -L long
-}
-if ((only_long)); then
-  long_runs
-  section "The long runs passed"
-  exit 0
-fi
-
 section "Setup"
 bash scripts/setup.sh --no-package --tests
 
@@ -102,19 +82,19 @@ bash scripts/setup.sh --no-package --tests
 # Clang's: GCC 12 instantiates this library's templates several times slower, and more than
 # linearly in a unit's size (a third of its time goes to walking lists of type variants,
 # get_qualified_type), so that one unit of the tests took it over an hour. Clang's back end at
-# -O1 pays for the volume instead: the whole suite took it over an hour, against 10 minutes at
-# -O0, where the suite runs about 10 times as long. So the test command compiles at -O0 the
-# files whose cases run in seconds to a minute even so (odyn_tests), and leaves out the long runs
-# (tests/CMakeLists.txt, ODYN_LONG_RUN_TESTS: their -O1 build alone takes both cores for over
-# half an hour); --long adds them, and .ci/run runs them when its time allows
+# -O1 pays for the volume instead, five times over with the sanitizers: the whole suite took it
+# over an hour. At -O0 it takes 10 minutes, and the suite runs about 10 times as long (the long
+# runs, 100 times). So the sanitizer build compiles at -O0 the files whose cases run in seconds
+# to a minute even so (odyn_tests), and at -O1 without the sanitizers the long runs
+# (odyn_tests_long: about 8 minutes of CPU to build, under a minute to run), in one build
 # (docs/benchmarks.md, "Compile time").
 # The Python package and the engine's module, which instantiate every element and analysis, are
 # Clang's too (ODYN_PACKAGE_CXX): it built one of their units in 306 s of CPU where GCC 12 took
 # over 850. GCC 12 compiles the engine example and the downstream program (.ci/run adds the
 # other examples and the benchmarks, the analyses' included, when its time allows). They run
 # beside the sanitizer build and runs at a lower priority, two units at a time, then the Python
-# tests. A unit of the tests peaks near 5 GB at -O0 and near 9 GB at -O1, a package unit near
-# 3 GB: a machine out of memory does not fail, it crawls.
+# tests. A unit of the tests peaks near 5 GB at -O0 and near 5 GB at -O1 (the long runs), a
+# package unit near 3 GB: a machine out of memory does not fail, it crawls.
 trap 'jobs -p | xargs -r kill 2>/dev/null' EXIT
 
 # finish <pid> <log> <what>: waits for a background step, shows its output, stops on failure.
@@ -180,10 +160,10 @@ pytest_pid=$!
 
 section "ASan + UBSan build of the tests (build-asan/, Clang)"
 configure_sanitizer_build
-cmake --build build-asan -j "$jobs" --target odyn_tests
+cmake --build build-asan -j "$jobs" --target odyn_tests odyn_tests_long
 
-section "ASan + UBSan tests (the Catch2 suite but its long runs, the allocation count included)"
-run_sanitizer_tests -LE long
+section "The Catch2 suite: ASan + UBSan (the allocation count included), and the long runs at -O1"
+run_sanitizer_tests
 
 section "Release engine example, install + downstream find_package(odyn)"
 finish "$release_pid" "$release_log" "the Release engine example or the downstream build"
@@ -193,7 +173,5 @@ finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
 
 section "Python tests"
 finish "$pytest_pid" "$pytest_log" "the Python tests"
-
-if ((long)); then long_runs; fi
 
 section "All checks passed"

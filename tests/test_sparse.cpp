@@ -4,8 +4,8 @@
 // (dense, CHOLMOD's Schur complement, KLU's whole matrix) against the dense LU on the same
 // model matrices; the sparse assembly against the dense one; redundancy named on a large
 // model; a chain's small oscillations on the sparse path against the frequencies of its
-// minimal-coordinate linearization, written out here from the Lagrangian; and a chain whipping
-// round under large constraint forces against the same chain in joint coordinates.
+// minimal-coordinate linearization, written out here from the Lagrangian. (The chain whipping
+// round under large constraint forces, a long run, is in test_joint_coordinates.cpp.)
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -860,65 +860,6 @@ TEST_CASE("Slender links spinning fast run with the defaults", "[sparse][hard]")
   CHECK(largest_rate > 5.0);  // rad/s: the links did whip about
   CHECK(ws.phi.cwiseAbs().maxCoeff() <= 1e-10);
   CHECK(integrator.statistics().newton_iterations <= 3 * integrator.statistics().steps);
-}
-
-}  // namespace test_sparse
-
-namespace test_sparse {
-
-TEST_CASE("A chain whipping round under large constraint forces runs with the defaults",
-          "[sparse][hard]") {
-  // 512 links of 1 m and 1 kg, horizontal, every link given a speed across: the assembly keeps
-  // what the joints allow, a zigzag whose links turn at twice that speed in rad/s. Their
-  // centripetal terms add up along the chain to a tension of about 2 (speed N)^2 newtons at the
-  // pivot (84 kN at 0.4 m/s), whose geometric stiffness is 14 % of the links' inertia over the
-  // step squared at h = 1e-3 and 0.4 m/s: without it in the Newton matrix the iteration
-  // contracts by only 1/10 a step, and this run stopped in its first step. At 0.8 m/s the
-  // first steps of 1 ms do not converge even so, and are cut (advance_to) until the chain has
-  // settled into its motion. Generalized-alpha with its defaults must run both and converge at
-  // second order to the same chain in joint coordinates (dop853 at 1e-11, no constraint
-  // equation at all), which the absolute-coordinate dop853 run confirms.
-  const int n = 512;
-  const double t_end = 0.05;
-  const auto speed = GENERATE(0.4, 0.8);
-  const ChainModel model = chain(n, false, 0.0, speed);
-  long rejected = 0;
-  const auto centres_at_end = [&](const char* integrator, const char* coordinates, double h) {
-    odyn::Workspace<ChainModel> ws(model);
-    odyn::DynamicsSettings settings;
-    settings.integrator = integrator;
-    settings.coordinates = coordinates;
-    settings.step = h;
-    settings.rtol = settings.atol = 1e-11;
-    settings.t_end = t_end;
-    settings.output_interval = t_end;
-    Eigen::VectorXd centres(3 * n);
-    const auto summary = odyn::simulate(model, ws, settings, [&](const auto& state) {
-      for (int b = 1; b <= n; ++b) centres.segment<3>(3 * (b - 1)) = state.frames[b].position;
-    });
-    rejected = summary.statistics.rejected_steps;
-    return centres;
-  };
-  const Eigen::VectorXd reference = centres_at_end("dop853", "joint", 1e-4);
-  CHECK((centres_at_end("dop853", "absolute", 1e-4) - reference).cwiseAbs().maxCoeff() < 1e-9);
-  Eigen::VectorXd coarse, fine;
-  REQUIRE_NOTHROW(coarse = centres_at_end("generalized-alpha", "absolute", 1e-3));
-  const long coarse_rejected = rejected;
-  REQUIRE_NOTHROW(fine = centres_at_end("generalized-alpha", "absolute", 5e-4));
-  const double coarse_error = (coarse - reference).cwiseAbs().maxCoeff();
-  const double fine_error = (fine - reference).cwiseAbs().maxCoeff();
-  INFO(speed << " m/s: errors " << coarse_error << " m at h = 1e-3 (" << coarse_rejected
-             << " attempts rejected), " << fine_error << " m at 5e-4 (" << rejected << ")");
-  if (speed == 0.4) {
-    CHECK(coarse_rejected == 0);
-    CHECK(coarse_error < 3e-3);              // the links moved about 2 cm; measured 1.9e-3
-    CHECK(coarse_error > 3.0 * fine_error);  // second order
-  } else {
-    CHECK(coarse_rejected > 0);    // the full step failed, and was cut
-    CHECK(coarse_error < 1.5e-2);  // the links moved about 4 cm; measured 1.2e-2
-    // Second order, less the steps that were cut anyway: measured 3.0.
-    CHECK(coarse_error > 2.5 * fine_error);
-  }
 }
 
 }  // namespace test_sparse

@@ -8,8 +8,7 @@
 #include <numbers>
 #include <string>
 
-#include <odyn/analysis/quasi_statics.hpp>
-#include <odyn/analysis/statics.hpp>
+#include <odyn/analyses.hpp>
 #include <odyn/odyn.hpp>
 
 #include "spring_plate.hpp"

@@ -169,6 +169,7 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
   };
   const double position_step = 1e-3 * std::min(1.0, length);
   const double speed_step = 1e-3 * std::max(1.0, v0.size() > 0 ? v0.cwiseAbs().maxCoeff() : 0.0);
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(n);  // no change along a direction
 
   // The velocities' change that keeps Phi_q v + Phi_t = 0 as the positions move along T.
   Eigen::MatrixXd velocity_change = Eigen::MatrixXd::Zero(n, k);
@@ -176,7 +177,6 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
     Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> inverse(jacobian);
     inverse.setThreshold(1e-10);
     Eigen::VectorXd rates(jacobian.rows()), drift_of_rates(jacobian.rows());
-    const Eigen::VectorXd none = Eigen::VectorXd::Zero(n);
     for (Eigen::Index j = 0; j < k; ++j) {
       fourth_order_difference(position_step, drift_of_rates, rates, [&](double s) {
         const auto [qs, vs] = move(basis.col(j), none, s);
@@ -203,7 +203,6 @@ StateSpace linearize_here(Coordinates& c, const Model& model, Workspace<Model>& 
   };
   out.a.resize(2 * k, 2 * k);
   out.c.resize(r, 2 * k);
-  const Eigen::VectorXd none = Eigen::VectorXd::Zero(n);
   for (Eigen::Index j = 0; j < 2 * k; ++j) {
     const bool along_z = j < k;
     const Eigen::VectorXd dq = along_z ? Eigen::VectorXd(basis.col(j)) : none;
