@@ -229,11 +229,13 @@ class JointCoordinates {
         for (const Screw& screw : node.screws) {
           const bool angular = screw.kind == Screw::Kind::rotation;
           const int number = angular ? ++turn : ++travel;
-          const bool numbered = (angular ? turns : travels) > 1;
-          out.push_back({node.joint,
-                         std::string(angular ? "angle" : "travel") +
-                             (numbered ? " " + std::to_string(number) : ""),
-                         angular});
+          // Appended piecewise: GCC 12's -Wrestrict misreads `" " + std::to_string(n)` at -O2.
+          std::string label = angular ? "angle" : "travel";
+          if ((angular ? turns : travels) > 1) {
+            label += ' ';
+            label += std::to_string(number);
+          }
+          out.push_back({node.joint, std::move(label), angular});
         }
       }
     }
