@@ -481,7 +481,7 @@ ChainRun run_chain_adaptive(const Chain& chain, const pc::Parameters& p, const s
 }
 
 TEST_CASE("bdf swings the chain of parallelograms through its singular configurations",
-          "[hard][singular][bdf][second_share]") {
+          "[hard][singular][bdf]") {
   // Near each crossing the rounding floor of bdf's corrections (what rounding alone makes of
   // them through the nearly singular matrices) passes the local tolerance: corrections at it
   // end the iteration, and the error test allows that noise instead of shortening the step
@@ -527,7 +527,7 @@ TEST_CASE("bdf swings the chain of parallelograms through its singular configura
 }
 
 TEST_CASE("dop853 and dopri5 swing the chain of parallelograms through its singular configurations",
-          "[hard][singular][explicit][second_share]") {
+          "[hard][singular][explicit]") {
   // Near a crossing the index-1 accelerations off the constraints are amplified by about
   // 1/sigma^2, and the stages lie off them by their own error: a rejected step far off its
   // target there (the rank checked by a QR) makes the explicit methods project every stage
