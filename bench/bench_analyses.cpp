@@ -1,16 +1,21 @@
-// Statics and modes of a large model on the sparse path (analysis/sparse_linearization.hpp)
-// against the dense one: a hanging chain of N hinged links (tests/hinge_chain.hpp), its lowest
-// 20 modes about the equilibrium, which statics first find from the chain turned by 0.1 rad.
-// One whole analysis per iteration (equilibrium, tangent, eigenvalues).
-// Run: build/bench/odyn_bench --benchmark_filter=HingeChain --benchmark_repetitions=5
-//      --benchmark_report_aggregates_only=true
+// The analyses of a large model on the sparse path against the dense one:
+//  - statics and modes (analysis/sparse_linearization.hpp): a hanging chain of N hinged links
+//    (tests/hinge_chain.hpp), its lowest 20 modes about the equilibrium, which statics first
+//    find from the chain turned by 0.1 rad; one whole analysis per iteration (equilibrium,
+//    tangent, eigenvalues);
+//  - kinematics (analysis/kinematics.hpp): a planar chain of N links, each hinge driven
+//    (tests/driven_chain.hpp), from its assembly over 0.1 s with an output every 0.01 s.
+// Run: build/bench/odyn_bench --benchmark_filter='HingeChain|DrivenChain'
+//      --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 
 #include <string>
 
+#include <odyn/analysis/kinematics.hpp>
 #include <odyn/analysis/modes.hpp>
 
+#include "driven_chain.hpp"
 #include "hinge_chain.hpp"
 
 namespace bench_analyses {
@@ -36,6 +41,33 @@ BENCHMARK(HingeChainModes)
     ->Args({200, 1})
     ->Args({1000, 1})
     ->Args({4000, 1})
+    ->Unit(benchmark::kMillisecond);
+
+/// Arguments: links, and 1 for the sparse rows, 0 for the dense matrices.
+void DrivenChainKinematics(benchmark::State& state) {
+  const int links = static_cast<int>(state.range(0));
+  const driven_chain::Chain chain = driven_chain::build(links);
+  odyn::KinematicSettings settings;
+  settings.linear_solver =
+      state.range(1) == 1 ? odyn::LinearSolver::klu : odyn::LinearSolver::dense;
+  double tip_angle = 0.0;
+  for (auto _ : state) {
+    odyn::Workspace<driven_chain::Model> ws(chain.model);
+    odyn::kinematic_analysis(
+        chain.model, ws, 0.1, 0.01, [&](const auto& s) { tip_angle = s.frames[links].angle; },
+        settings);
+  }
+  // Against forward kinematics at the end.
+  state.counters["tip_angle_error"] =
+      std::abs(tip_angle - driven_chain::chain_at(links, 0.1).back().angle);
+  state.SetLabel(state.range(1) == 1 ? "sparse" : "dense");
+}
+BENCHMARK(DrivenChainKinematics)
+    ->Args({100, 0})
+    ->Args({100, 1})
+    ->Args({1000, 1})
+    ->Args({4000, 1})
+    ->Args({16000, 1})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace bench_analyses

@@ -1,5 +1,6 @@
 // Kinematic analysis (analysis/kinematics.hpp): a fully driven mechanism against closed forms,
-// and the mechanisms it must refuse.
+// and the mechanisms it must refuse, with dense matrices and on sparse rows (the path of large
+// models, forced here by naming a sparse solver).
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -9,11 +10,19 @@
 #include <odyn/analysis/kinematics.hpp>
 #include <odyn/odyn.hpp>
 
+#include "driven_chain.hpp"
 #include "four_bar_model.hpp"
 
 namespace test_kinematics {
 
 namespace pl = odyn::planar;
+
+// The two linear algebras of a kinematic analysis.
+odyn::KinematicSettings with_solver(odyn::LinearSolver solver) {
+  odyn::KinematicSettings s;
+  s.linear_solver = solver;
+  return s;
+}
 
 // The rocker angle of the open four-bar for a crank angle, from Freudenstein's equation (as in
 // test_planar.cpp), and its first two time derivatives by central differences of it.
@@ -48,6 +57,8 @@ TEST_CASE(
     "A driven four-bar moves as Freudenstein's equation says, with the motor's torque "
     "from the power balance",
     "[kinematics]") {
+  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
+  INFO("linear solver " << odyn::linear_solver_name(solver));
   const Freudenstein reference;
   const four_bar::Parameters& p = reference.p;
   four_bar::Linkage l = four_bar::build(p);
@@ -55,21 +66,24 @@ TEST_CASE(
   std::vector<double> times, energy, power;
   double angle_error = 0.0, rate_error = 0.0, acceleration_error = 0.0;
   double largest_rate = 0.0, largest_acceleration = 0.0;
-  odyn::kinematic_analysis(l.model, ws, 1.0, 1e-3, [&](const auto& s) {
-    const auto& rocker = s.frames[l.rocker.index];
-    CHECK(s.frames[l.crank.index].angle == Approx(p.speed * s.t).margin(1e-12));
-    angle_error =
-        std::max(angle_error, std::abs(rocker.angle - wrapped(reference.at(s.t), rocker.angle)));
-    const int spin = (l.rocker.index - 1) * 3 + 2;  // the rocker's angular velocity coordinate
-    rate_error = std::max(rate_error, std::abs(s.v[spin] - reference.rate(s.t)));
-    acceleration_error =
-        std::max(acceleration_error, std::abs(s.vdot[spin] - reference.acceleration(s.t)));
-    largest_rate = std::max(largest_rate, std::abs(s.v[spin]));
-    largest_acceleration = std::max(largest_acceleration, std::abs(s.vdot[spin]));
-    times.push_back(s.t);
-    energy.push_back(odyn::kinetic_energy(l.model, s) + odyn::potential_energy(l.model, s));
-    power.push_back(odyn::reaction(l.model, s, l.motor, odyn::Side::b).torque[0] * p.speed);
-  });
+  odyn::kinematic_analysis(
+      l.model, ws, 1.0, 1e-3,
+      [&](const auto& s) {
+        const auto& rocker = s.frames[l.rocker.index];
+        CHECK(s.frames[l.crank.index].angle == Approx(p.speed * s.t).margin(1e-12));
+        angle_error = std::max(angle_error,
+                               std::abs(rocker.angle - wrapped(reference.at(s.t), rocker.angle)));
+        const int spin = (l.rocker.index - 1) * 3 + 2;  // the rocker's angular velocity coordinate
+        rate_error = std::max(rate_error, std::abs(s.v[spin] - reference.rate(s.t)));
+        acceleration_error =
+            std::max(acceleration_error, std::abs(s.vdot[spin] - reference.acceleration(s.t)));
+        largest_rate = std::max(largest_rate, std::abs(s.v[spin]));
+        largest_acceleration = std::max(largest_acceleration, std::abs(s.vdot[spin]));
+        times.push_back(s.t);
+        energy.push_back(odyn::kinetic_energy(l.model, s) + odyn::potential_energy(l.model, s));
+        power.push_back(odyn::reaction(l.model, s, l.motor, odyn::Side::b).torque[0] * p.speed);
+      },
+      with_solver(solver));
   REQUIRE(times.size() == 1001);
   CHECK(times.back() == Approx(1.0).margin(1e-12));
   CHECK(angle_error < 1e-11);
@@ -148,22 +162,27 @@ TEST_CASE(
                  g * (rod_mass * (r * c + out.z) / 2.0 + piston_mass * out.z);
     return out;
   };
+  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
+  INFO("linear solver " << odyn::linear_solver_name(solver));
   odyn::Workspace<Model> ws(m);
   double z_error = 0.0, rate_error = 0.0, acceleration_error = 0.0, torque_error = 0.0;
   double largest_acceleration = 0.0, largest_torque = 0.0;
   const int lift = (piston.index - 1) * 6 + 2;  // the piston's z velocity coordinate
-  odyn::kinematic_analysis(m, ws, 0.1, 2e-4, [&](const auto& s) {
-    const Closed c = closed(s.t);
-    z_error = std::max(z_error, std::abs(s.frames[piston.index].position.z() - c.z));
-    rate_error = std::max(rate_error, std::abs(s.v[lift] - c.rate));
-    acceleration_error = std::max(acceleration_error, std::abs(s.vdot[lift] - c.acceleration));
-    largest_acceleration = std::max(largest_acceleration, std::abs(c.acceleration));
-    const double h = 1e-6;  // the energy's rate, by a central difference of the closed form
-    const double power = (closed(s.t + h).energy - closed(s.t - h).energy) / (2.0 * h);
-    const double torque = odyn::reaction(m, s, motor, odyn::Side::b).torque.x();
-    torque_error = std::max(torque_error, std::abs(torque - power / omega));
-    largest_torque = std::max(largest_torque, std::abs(power / omega));
-  });
+  odyn::kinematic_analysis(
+      m, ws, 0.1, 2e-4,
+      [&](const auto& s) {
+        const Closed c = closed(s.t);
+        z_error = std::max(z_error, std::abs(s.frames[piston.index].position.z() - c.z));
+        rate_error = std::max(rate_error, std::abs(s.v[lift] - c.rate));
+        acceleration_error = std::max(acceleration_error, std::abs(s.vdot[lift] - c.acceleration));
+        largest_acceleration = std::max(largest_acceleration, std::abs(c.acceleration));
+        const double h = 1e-6;  // the energy's rate, by a central difference of the closed form
+        const double power = (closed(s.t + h).energy - closed(s.t - h).energy) / (2.0 * h);
+        const double torque = odyn::reaction(m, s, motor, odyn::Side::b).torque.x();
+        torque_error = std::max(torque_error, std::abs(torque - power / omega));
+        largest_torque = std::max(largest_torque, std::abs(power / omega));
+      },
+      with_solver(solver));
   INFO("piston: z error " << z_error << " m, rate error " << rate_error
                           << " m/s, acceleration error " << acceleration_error << " of "
                           << largest_acceleration << " m/s^2; motor torque error " << torque_error
@@ -176,6 +195,8 @@ TEST_CASE(
 
 TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or over-driven",
           "[kinematics]") {
+  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
+  INFO("linear solver " << odyn::linear_solver_name(solver));
   SECTION("a degree of freedom left") {
     using Model = pl::Model<pl::Revolute, pl::Gravity>;
     Model m;
@@ -184,7 +205,8 @@ TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or
     m.add(pl::Revolute("pivot", odyn::ground, {{0.0, 0.0}}, bar, {{-0.5, 0.0}}));
     odyn::Workspace<Model> ws(m);
     CHECK_THROWS_WITH(
-        odyn::kinematic_analysis(m, ws, 1.0, 0.1, [](const auto&) {}),
+        odyn::kinematic_analysis(
+            m, ws, 1.0, 0.1, [](const auto&) {}, with_solver(solver)),
         Catch::Contains("1 degree of freedom remain") && Catch::Contains("its drivers: none"));
   }
   SECTION("a driver that repeats another") {
@@ -192,7 +214,8 @@ TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or
     const pl::Revolute& o2 = l.model.element(l.o2);
     l.model.add(pl::RevoluteDriver("second motor", o2, odyn::Motion::constant_velocity(1.0)));
     odyn::Workspace<four_bar::Model> ws(l.model);
-    CHECK_THROWS_WITH(odyn::kinematic_analysis(l.model, ws, 1.0, 0.1, [](const auto&) {}),
+    CHECK_THROWS_WITH(odyn::kinematic_analysis(
+                          l.model, ws, 1.0, 0.1, [](const auto&) {}, with_solver(solver)),
                       Catch::Contains("over-driven") && Catch::Contains("motor'"));
   }
 }
@@ -216,16 +239,97 @@ TEST_CASE("A crank driven past its dead centre locks up, named with its time", "
   m.add(pl::Translational("slide", odyn::ground, {{0.0, 0.0}, {1.0, 0.0}}, slider,
                           {{0.0, 0.0}, {1.0, 0.0}}));
   m.add(pl::RevoluteDriver("motor", pivot, odyn::Motion::constant_velocity(speed)));
+  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
+  INFO("linear solver " << odyn::linear_solver_name(solver));
   odyn::Workspace<Model> ws(m);
   double last = 0.0;
   const double lock = std::asin(rod / crank) / speed;  // the rod square to the slide
-  REQUIRE_THROWS_AS(odyn::kinematic_analysis(m, ws, 2.0, 0.01, [&](const auto& s) { last = s.t; }),
+  REQUIRE_THROWS_AS(odyn::kinematic_analysis(
+                        m, ws, 2.0, 0.01, [&](const auto& s) { last = s.t; }, with_solver(solver)),
                     odyn::AssemblyError);
   CHECK(last < lock);
   CHECK(last > lock - 0.011);
   odyn::Workspace<Model> again(m);
-  CHECK_THROWS_WITH(odyn::kinematic_analysis(m, again, 2.0, 0.01, [](const auto&) {}),
+  CHECK_THROWS_WITH(odyn::kinematic_analysis(
+                        m, again, 2.0, 0.01, [](const auto&) {}, with_solver(solver)),
                     Catch::Contains("locks up after t = 0.5235"));
+}
+
+TEST_CASE(
+    "A long driven chain moves as its forward kinematics say, with the motors' torques and the "
+    "hinges' forces of a recursive Newton-Euler pass",
+    "[kinematics]") {
+  // tests/driven_chain.hpp: N links hinged end to end, each hinge's angle driven. A pass from
+  // the tip to the root gives the force F_i that link i - 1 exerts on link i through hinge i
+  // and the motor's torque tau_i:
+  //   F_i = m_i (a_i - g) + F_(i+1),
+  //   tau_i = I_i alpha_i + tau_(i+1) - (p_i - c_i) x F_i + (p_(i+1) - c_i) x F_(i+1),
+  // with p_i the hinge's point and c_i the link's centre. At N = 60 (180 velocities, 180
+  // equations) the analysis takes the sparse path by itself; the dense one is checked too.
+  using driven_chain::length;
+  using Eigen::Vector2d;
+  constexpr int links = 60;
+  const driven_chain::Chain chain = driven_chain::build(links);
+  const driven_chain::Model& m = chain.model;
+  REQUIRE(odyn::detail::sparse_kinematics(m, odyn::LinearSolver::automatic));
+  auto cross = [](const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+
+  const auto solver = GENERATE(odyn::LinearSolver::automatic, odyn::LinearSolver::dense);
+  INFO("linear solver " << odyn::linear_solver_name(solver));
+  odyn::Workspace<driven_chain::Model> ws(m);
+  double position_error = 0.0, velocity_error = 0.0, acceleration_error = 0.0;
+  double torque_error = 0.0, largest_torque = 0.0, force_error = 0.0, largest_force = 0.0;
+  int outputs = 0;
+  odyn::kinematic_analysis(
+      m, ws, 0.5, 0.05,
+      [&](const auto& s) {
+        ++outputs;
+        const std::vector<driven_chain::Link> expected = driven_chain::chain_at(links, s.t);
+        for (int i = 0; i < links; ++i) {
+          const driven_chain::Link& e = expected[i];
+          const auto& frame = s.frames[i + 1];
+          position_error = std::max({position_error, (frame.position - e.centre).norm(),
+                                     std::abs(frame.angle - e.angle)});
+          const auto v = s.v.template segment<3>(3 * i), a = s.vdot.template segment<3>(3 * i);
+          velocity_error = std::max({velocity_error, (v.template head<2>() - e.velocity).norm(),
+                                     std::abs(v[2] - e.rate)});
+          acceleration_error =
+              std::max({acceleration_error, (a.template head<2>() - e.acceleration).norm(),
+                        std::abs(a[2] - e.angular_acceleration)});
+        }
+        // The tip-to-root pass.
+        Vector2d force_above = Vector2d::Zero();
+        double torque_above = 0.0;
+        for (int i = links - 1; i >= 0; --i) {
+          const driven_chain::Link& e = expected[i];
+          const double mass = driven_chain::mass(i);
+          const Vector2d force = mass * (e.acceleration - driven_chain::gravity) + force_above;
+          const Vector2d tip = e.centre + (e.centre - e.hinge);
+          const double torque = mass * length * length / 12.0 * e.angular_acceleration +
+                                torque_above - cross(e.hinge - e.centre, force) +
+                                cross(tip - e.centre, force_above);
+          const auto hinge = odyn::reaction(m, s, chain.hinges[i], odyn::Side::b);
+          const auto motor = odyn::reaction(m, s, chain.motors[i], odyn::Side::b);
+          force_error = std::max(force_error, (hinge.force + motor.force - force).norm());
+          torque_error =
+              std::max(torque_error, std::abs(hinge.torque[0] + motor.torque[0] - torque));
+          largest_force = std::max(largest_force, force.norm());
+          largest_torque = std::max(largest_torque, std::abs(torque));
+          force_above = force;
+          torque_above = torque;
+        }
+      },
+      with_solver(solver));
+  INFO("errors: position " << position_error << ", velocity " << velocity_error << ", acceleration "
+                           << acceleration_error << ", force " << force_error << " of "
+                           << largest_force << " N, torque " << torque_error << " of "
+                           << largest_torque << " N m");
+  CHECK(outputs == 11);
+  CHECK(position_error < 1e-11);
+  CHECK(velocity_error < 1e-10);
+  CHECK(acceleration_error < 1e-9);
+  CHECK(force_error < 1e-10 * largest_force);
+  CHECK(torque_error < 1e-10 * largest_torque);
 }
 
 }  // namespace test_kinematics

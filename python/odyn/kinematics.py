@@ -8,9 +8,9 @@ from typing import Any, Callable, Dict, List, Optional
 import numpy as np
 
 from . import modules
-from ._schema import check_number, fail
+from ._schema import check_choice, check_number, fail
 from .model import BaseModel
-from .results import Result, finished_run
+from .results import LINEAR_SOLVERS, Result, finished_run
 
 
 def _whole(value: Any, name: str, least: int) -> int:
@@ -21,6 +21,7 @@ def _whole(value: Any, name: str, least: int) -> int:
 
 def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float = 1e-3,
                tolerance: float = 1e-12, max_iterations: int = 25, max_halvings: int = 12,
+               linear_solver: str = "auto",
                progress: Optional[Callable[[float], None]] = None) -> Result:
     """Moves a fully driven mechanism (as many drivers as degrees of freedom) as its drivers
     prescribe, from t = 0 to t_end, whatever its masses; a row every `output_interval`.
@@ -31,7 +32,10 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
     of motion, which makes this the inverse dynamics too: `result.reaction(driver).torque` (or
     `.force`, for a translational driver) is the effort the driver must apply to its body b, and
     every joint's reaction is there. A time whose Newton iteration
-    fails is reached in up to `max_halvings` halves of the step.
+    fails is reached in up to `max_halvings` halves of the step. linear_solver: "dense" (a
+    rank-revealing QR of whole matrices), "klu" or "cholmod" (the same here: sparse rows and a
+    sparse LU, linear in the model's size) or "auto" (dense for small models, sparse above
+    100 velocities plus equations).
 
     Raises odyn.ModelError before it starts if the mechanism is not fully driven (how many
     degrees of freedom remain, and its drivers) or over-driven (which driver repeats the
@@ -47,7 +51,8 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
                                                 positive=True),
                 "tolerance": check_number(tolerance, "tolerance", positive=True),
                 "max_iterations": _whole(max_iterations, "max_iterations", 1),
-                "max_halvings": _whole(max_halvings, "max_halvings", 0)}
+                "max_halvings": _whole(max_halvings, "max_halvings", 0),
+                "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)}
     data = modules.analysis(model.module, "kinematics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)
@@ -131,15 +136,18 @@ class ModelReport:
         return "\n".join(self.lines())
 
 
-def check(model: BaseModel, *, tolerance: float = 1e-12, max_iterations: int = 50) -> ModelReport:
+def check(model: BaseModel, *, tolerance: float = 1e-12, max_iterations: int = 50,
+          linear_solver: str = "auto") -> ModelReport:
     """Assembles the model and reports what its constraints leave free there: Gruebler's count
     and the true degrees of freedom (from the constraint Jacobian's rank), the redundant
     equations and the joints that over-constrain, the drivers, and what the assembly did (the
     bodies it moved, the given velocity components it kept or changed). `print(report)` gives
-    it as text. Raises odyn.AssemblyError if the model does not assemble."""
+    it as text. Raises odyn.AssemblyError if the model does not assemble. linear_solver: as
+    in `kinematics` (the rank of large models' Jacobians by sparse elimination)."""
     data = modules.analysis(model.module, "check")(model._core, {
         "assembly_tolerance": check_number(tolerance, "tolerance", positive=True),
-        "assembly_max_iterations": _whole(max_iterations, "max_iterations", 1)})
+        "assembly_max_iterations": _whole(max_iterations, "max_iterations", 1),
+        "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
     data["summary"] = None
     data["points"] = model._point_table()
     data["point_axes"] = model._point_axes()

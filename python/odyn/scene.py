@@ -26,7 +26,7 @@
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
                    generalized-alpha when a step is given without rtol and atol;
                    "type": "dynamic" (the default), "kinematic" (odyn.kinematics: t_end,
-                   output_interval, max_iterations), "static" or "modes" (odyn.statics,
+                   output_interval, max_iterations, linear_solver), "static" or "modes" (odyn.statics,
                    odyn.modes: max_iterations, coordinates "absolute" or "joint"),
                    "quasi_static" (odyn.quasi_statics: t_end, output_interval,
                    max_iterations, coordinates, max_halvings) or "linear" (odyn.linearize:
@@ -98,7 +98,7 @@ ANALYSIS_OPTIONAL = ("type", "integrator", "rho_inf", "step", "rtol", "atol", "m
 #: output_interval (which only the analyses in TIMED use).
 ANALYSES: Dict[str, Tuple[str, ...]] = {
     "dynamic": ANALYSIS_OPTIONAL[1:ANALYSIS_OPTIONAL.index("max_halvings")],
-    "kinematic": ("max_iterations",),
+    "kinematic": ("max_iterations", "linear_solver"),
     "quasi_static": ("max_iterations", "coordinates", "max_halvings"),
     "static": ("max_iterations", "coordinates"),
     "modes": ("max_iterations", "coordinates"),

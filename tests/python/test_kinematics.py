@@ -53,9 +53,11 @@ def closed_form(theta, omega):
     return [tuple(k * f for k, f in zip(scale, q)) for q in (x, phi, centre_x, centre_y)]
 
 
-def test_a_driven_slider_crank_follows_its_closed_form_and_power_balance():
+@pytest.mark.parametrize("solver", ["dense", "klu"])
+def test_a_driven_slider_crank_follows_its_closed_form_and_power_balance(solver):
     omega = 20.0
-    r = odyn.kinematics(slider_crank(omega), t_end=0.5, output_interval=0.01)
+    r = odyn.kinematics(slider_crank(omega), t_end=0.5, output_interval=0.01,
+                        linear_solver=solver)
     assert len(r) == 51 and r.kinematics["outputs"] == 51
     piston, rod = r.body("piston"), r.body("rod")
     torque = r.reaction("motor").torque
@@ -97,12 +99,14 @@ def test_an_over_driven_mechanism_names_the_driver():
         odyn.kinematics(slider_crank(10.0, second_motor=True), t_end=0.1)
 
 
-def test_a_lock_up_is_named_with_its_time_and_keeps_the_rows_before_it():
+@pytest.mark.parametrize("solver", ["dense", "klu"])
+def test_a_lock_up_is_named_with_its_time_and_keeps_the_rows_before_it(solver):
     """With the rod shorter than the crank, the crank cannot pass R sin(theta) = rod."""
     omega, rod = 10.0, 0.06
     lock = math.asin(rod / R) / omega
     with pytest.raises(odyn.AssemblyError, match="locks up") as error:
-        odyn.kinematics(slider_crank(omega, rod=rod), t_end=0.5, output_interval=0.005)
+        odyn.kinematics(slider_crank(omega, rod=rod), t_end=0.5, output_interval=0.005,
+                        linear_solver=solver)
     rows = error.value.result
     assert 0 < len(rows) and rows.t[-1] <= lock < rows.t[-1] + 0.005 + 1e-12
 
@@ -112,6 +116,50 @@ def test_bad_settings_are_refused_by_name():
         odyn.kinematics(slider_crank(1.0), output_interval=0.0)
     with pytest.raises(odyn.SceneError, match="max_halvings"):
         odyn.kinematics(slider_crank(1.0), max_halvings=-1)
+    with pytest.raises(odyn.SceneError, match="linear_solver"):
+        odyn.kinematics(slider_crank(1.0), linear_solver="umfpack")
+
+
+def driven_chain(links, driven=True):
+    """A planar chain of 0.5 m links hinged end to end from the ground, straight along x, each
+    hinge's angle driven at 1 rad/s (or left free)."""
+    m = odyn.PlanarModel()
+    for i in range(links):
+        m.add_body(name=f"link{i}", mass=1.0, inertia=0.02, position=[0.25 + 0.5 * i, 0])
+        m.add_revolute(name=f"hinge{i}", body_a="ground" if i == 0 else f"link{i - 1}",
+                       on_a=odyn.frame([0 if i == 0 else 0.25, 0]), body_b=f"link{i}",
+                       on_b=odyn.frame([-0.25, 0]))
+        if driven:
+            m.add_revolute_driver(name=f"motor{i}", joint=f"hinge{i}",
+                                  motion=odyn.constant_velocity(1.0))
+    return m
+
+
+def test_a_large_driven_chain_curls_as_its_motors_say():
+    """400 links (2400 velocities and equations: the sparse path). Each hinge turns at 1 rad/s,
+    so link i turns at (i + 1) rad/s and the chain curls into arcs of a circle."""
+    links = 400
+    r = odyn.kinematics(driven_chain(links), t_end=0.02, output_interval=0.01)
+    assert len(r) == 3
+    for i in (0, 1, links // 2, links - 1):
+        link = r.body(f"link{i}")
+        np.testing.assert_allclose(link.angle, (i + 1) * r.t, atol=1e-12)
+        np.testing.assert_allclose(link.angular_velocity, i + 1, rtol=1e-12)
+        np.testing.assert_allclose(link.angular_acceleration, 0, atol=1e-9)
+    # The tip's hinge point: the sum of the links' half-length steps along their angles.
+    t = r.t[-1]
+    angles = (np.arange(links) + 1) * t
+    tip = 0.5 * np.array([np.cos(angles).sum(), np.sin(angles).sum()])
+    last = r.body(f"link{links - 1}")
+    end = last.position[-1] + 0.25 * np.array([math.cos(last.angle[-1]), math.sin(last.angle[-1])])
+    np.testing.assert_allclose(end, tip, atol=1e-10)
+
+
+def test_check_counts_the_freedom_of_a_large_chain():
+    """600 undriven hinges: 600 degrees of freedom, from the sparse rank pass."""
+    report = odyn.check(driven_chain(600, driven=False))
+    assert (report.velocities, report.equations, report.rank) == (1800, 1200, 1200)
+    assert report.degrees_of_freedom == 600 and report.redundant_equations == []
 
 
 def test_check_counts_a_slider_crank():
@@ -213,6 +261,14 @@ def test_scenes_name_the_analysis_and_the_command_line_runs_it(tmp_path, capsys)
     table = np.genfromtxt(out, delimiter=",", names=True)
     for t, x in zip(table["t"], table["x"]):
         assert x == pytest.approx(closed_form(omega * t, omega)[0][0], abs=1e-11)
+    # On sparse rows, as a large model's analysis runs.
+    assert cli.main(["run", str(path), "--linear-solver", "klu", "--quiet",
+                     "--out", str(out)]) == 0
+    sparse = np.genfromtxt(out, delimiter=",", names=True)
+    for t, x in zip(sparse["t"], sparse["x"]):
+        assert x == pytest.approx(closed_form(omega * t, omega)[0][0], abs=1e-11)
+    np.testing.assert_allclose(sparse["torque"], table["torque"],
+                               atol=1e-10 * np.abs(table["torque"]).max())
     # Asked for by name instead, the dynamic analysis runs the same scene (the driver moves
     # the crank as before).
     assert cli.main(["run", str(path), "--analysis", "dynamic", "--quiet", "--rtol", "1e-10",

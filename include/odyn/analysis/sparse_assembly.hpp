@@ -164,13 +164,16 @@ RowOrder row_order(const Model& model) {
 }
 
 /// independent_rows in a given order. `fill`, if given, receives the entries the elimination
-/// stored (its memory, for the tests).
+/// stored (its memory, for the tests); `margins`, if given, each row's margin from depending
+/// on the rows before it in that order (SparseBasis::last_margin).
 inline std::vector<char> independent_rows(const RowOrder& order, const SparseRows& rows,
-                                          double tolerance, std::size_t* fill = nullptr) {
+                                          double tolerance, std::size_t* fill = nullptr,
+                                          std::vector<double>* margins = nullptr) {
   SparseBasis basis;
   basis.reset(rows.num_columns, tolerance);
   basis.rank_entries(&order.column_depth);
   std::vector<char> independent(static_cast<std::size_t>(rows.num_rows()), 0);
+  if (margins != nullptr) margins->assign(independent.size(), 0.0);
   std::vector<int> indices;
   std::vector<double> values;
   for (const RowOrder::Rows& element : order.elements)
@@ -179,6 +182,7 @@ inline std::vector<char> independent_rows(const RowOrder& order, const SparseRow
                      rows.columns.begin() + rows.starts[r + 1]);
       values.assign(rows.values.begin() + rows.starts[r], rows.values.begin() + rows.starts[r + 1]);
       independent[r] = basis.add(indices, values, element.pivot_begin, element.pivot_end) ? 1 : 0;
+      if (margins != nullptr) (*margins)[r] = basis.last_margin();
     }
   if (fill != nullptr) *fill = basis.stored_entries();
   return independent;

@@ -87,6 +87,7 @@ class SparseBasis {
         largest = std::abs(work_[i]);
         largest_index = i;
       }
+    last_margin_ = scale > 0.0 ? largest / scale : 0.0;
     const bool independent = scale > 0.0 && largest > tolerance_ * scale;
     if (independent) {
       double preferred = 0.0;
@@ -129,6 +130,9 @@ class SparseBasis {
   }
 
   int rank() const { return static_cast<int>(pivots_.size()); }
+  /// What reduction left of the last vector added, relative to its largest entry: 0 for a
+  /// vector that depends on the kept ones, near 1 for one far from them.
+  double last_margin() const { return last_margin_; }
   /// Entries kept for the reduced vectors (their fill).
   std::size_t stored_entries() const { return entry_index_.size(); }
 
@@ -149,6 +153,7 @@ class SparseBasis {
   static constexpr double pivot_threshold = 0.1;  // for a preferred pivot
   double tolerance_ = 0.0;
   const std::vector<int>* rank_ = nullptr;  // see rank_entries
+  double last_margin_ = 0.0;
   std::vector<int> pivot_of_;       // (dimension) the kept vector pivoting on each entry, or -1
   std::vector<double> work_;        // (dimension) the vector being reduced
   std::vector<char> touched_mark_;  // (dimension)

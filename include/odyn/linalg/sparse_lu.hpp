@@ -53,6 +53,11 @@ class SparseLu {
   /// x <- A^-1 x.
   void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { impl_->solve_in_place(x); }
 
+  /// x <- A^-T x, with the same factors (a kinematic analysis's multipliers).
+  void solve_transposed_in_place(Eigen::Ref<Eigen::VectorXd> x) {
+    impl_->solve_transposed_in_place(x);
+  }
+
   /// Factorizations that chose their pivots afresh (the others reused them).
   long pivoting_factorizations() const { return impl_->pivoting; }
 
@@ -117,6 +122,10 @@ class SparseLu {
     void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) {
       klu_solve(symbolic, numeric, static_cast<int>(x.size()), 1, x.data(), &common);
     }
+
+    void solve_transposed_in_place(Eigen::Ref<Eigen::VectorXd> x) {
+      klu_tsolve(symbolic, numeric, static_cast<int>(x.size()), 1, x.data(), &common);
+    }
   };
 #else
   struct Impl {
@@ -150,6 +159,10 @@ class SparseLu {
     }
 
     void solve_in_place(Eigen::Ref<Eigen::VectorXd> x) { x = lu.solve(Eigen::VectorXd(x)); }
+
+    void solve_transposed_in_place(Eigen::Ref<Eigen::VectorXd> x) {
+      x = lu.transpose().solve(Eigen::VectorXd(x));
+    }
   };
 #endif
   std::unique_ptr<Impl> impl_;

@@ -644,6 +644,7 @@ inline KinematicSettings kinematic_settings(const py::dict& d) {
   s.tolerance = get(d, "tolerance", s.tolerance);
   s.max_iterations = get(d, "max_iterations", s.max_iterations);
   s.max_halvings = get(d, "max_halvings", s.max_halvings);
+  s.linear_solver = linear_solver_from_name(get(d, "linear_solver", std::string("auto")));
   return s;
 }
 
@@ -740,7 +741,7 @@ py::dict check(Box& box, const py::dict& settings) {
     Found f;
     f.given = ws.v;
     f.assembly = odyn::assemble(box.model, ws, s);
-    f.mobility = odyn::mobility(box.model, ws);
+    f.mobility = odyn::mobility(box.model, ws, s.linear_solver);
     return f;
   });
   out["assembly"] = assembly_report(found.assembly);
