@@ -11,12 +11,14 @@
 // cannot give) are refused by name.
 // Small models use dense matrices (a rank-revealing QR of Phi_q). Large ones use sparse rows:
 // the assembly's rank pass in the model's topological order keeps n independent rows of
-// Phi_q, whose square matrix one sparse LU factorizes for the three solves of a time (the
-// multipliers with its transpose), at a cost linear in the model's size.
+// Phi_q, whose square matrix a sparse LU factorizes for the Newton steps and for the three
+// solves of a time (the multipliers with its transpose), at a cost linear in the model's size
+// (see SparseKinematics).
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -146,74 +148,17 @@ void require_fully_driven(const Model& model, Workspace<Model>& ws,
 }
 
 namespace detail {
-/// solve_kinematics's velocities, accelerations and multipliers on sparse rows, at solved
-/// positions. A constraint row that repeats others gets no multiplier (0): with redundant
-/// joints the reactions are one valid choice, not the minimum-norm one of the dense path.
+/// The dense path of solve_kinematics: a rank-revealing QR of the whole Jacobian.
 template <class Model>
-void solve_kinematics_sparse(const Model& model, Workspace<Model>& ws) {
-  const int n = model.num_velocities();
-  const SparseRows rows = sparse_jacobian(model, ws);
-  const std::vector<char> independent = independent_rows(model, rows, rank_tolerance);
-  std::vector<int> kept, dependent;  // rows of Phi_q
-  for (int r = 0; r < rows.num_rows(); ++r) (independent[r] ? kept : dependent).push_back(r);
-  if (static_cast<int>(kept.size()) < n) throw_lock_up(model, ws.t, dependent);
-  // The kept rows, a square matrix, by columns for the LU (row k of it is row kept[k]).
-  std::vector<int> starts(static_cast<std::size_t>(n) + 1, 0);
-  for (const int r : kept)
-    for (int e = rows.starts[r]; e < rows.starts[r + 1]; ++e) ++starts[rows.columns[e] + 1];
-  for (int j = 0; j < n; ++j) starts[j + 1] += starts[j];
-  std::vector<int> row_indices(static_cast<std::size_t>(starts[n]));
-  std::vector<double> values(row_indices.size());
-  std::vector<int> next(starts.begin(), starts.end() - 1);
-  for (int k = 0; k < n; ++k)
-    for (int e = rows.starts[kept[k]]; e < rows.starts[kept[k] + 1]; ++e) {
-      const int at = next[rows.columns[e]]++;
-      row_indices[at] = k;
-      values[at] = rows.values[e];
-    }
-  SparseLu lu;
-  lu.analyze(n, starts, row_indices);
-  if (!lu.factorize(values, SparseLu::independent_rows_ratio)) throw_lock_up(model, ws.t, {});
-  Eigen::VectorXd v(n), vdot(n);
-  for (int k = 0; k < n; ++k) v[k] = -ws.phi_t[kept[k]];
-  lu.solve_in_place(v);
-  ws.v = v;
-  update_frames(model, ws);
-  evaluate_constraints(model, ws);
-  initialize_states(model, ws);
-  evaluate_forces(model, ws);
-  evaluate_gamma(model, ws);
-  for (int k = 0; k < n; ++k) vdot[k] = ws.gamma[kept[k]];
-  lu.solve_in_place(vdot);  // Phi_q v' = gamma
-  ws.vdot = vdot;
-  Eigen::VectorXd multipliers(n);
-  mass_times(model, ws.vdot, multipliers);
-  multipliers = ws.force - multipliers;
-  lu.solve_transposed_in_place(multipliers);  // Phi_q^T lambda = Q - M v'
-  ws.lambda.setZero();
-  for (int k = 0; k < n; ++k) ws.lambda[kept[k]] = multipliers[k];
-  if (!v.allFinite() || !vdot.allFinite() || !multipliers.allFinite())
-    throw_lock_up(model, ws.t, {});
-}
-}  // namespace detail
-
-/// Solves positions, velocities, accelerations and multipliers at time ws.t, from a nearby
-/// configuration in ws.q. Throws AssemblyError at a lock-up (Newton fails, or Phi_q loses
-/// rank), naming the time and the equations that became dependent.
-template <class Model>
-void solve_kinematics(const Model& model, Workspace<Model>& ws, const KinematicSettings& s = {}) {
+void solve_kinematics_dense(const Model& model, Workspace<Model>& ws, const KinematicSettings& s) {
   AssemblySettings positions;
   positions.tolerance = s.tolerance;
   positions.max_iterations = s.max_iterations;
-  positions.linear_solver =
-      detail::sparse_kinematics(model, s.linear_solver) ? s.linear_solver : LinearSolver::dense;
+  positions.linear_solver = LinearSolver::dense;
   assemble_positions(model, ws, positions);
-  if (positions.linear_solver != LinearSolver::dense)
-    return detail::solve_kinematics_sparse(model, ws);
-  const Eigen::MatrixXd jacobian = detail::dense_jacobian(model, ws);
+  const Eigen::MatrixXd jacobian = dense_jacobian(model, ws);
   const RankRevealingQr qr(jacobian, rank_tolerance);
-  if (qr.rank() < model.num_velocities())
-    detail::throw_lock_up(model, ws.t, detail::dependent_rows(jacobian));
+  if (qr.rank() < model.num_velocities()) throw_lock_up(model, ws.t, dependent_rows(jacobian));
   ws.v = -qr.solve(ws.phi_t);
   update_frames(model, ws);
   evaluate_constraints(model, ws);
@@ -225,6 +170,163 @@ void solve_kinematics(const Model& model, Workspace<Model>& ws, const KinematicS
   Eigen::VectorXd inertial(model.num_velocities());
   mass_times(model, ws.vdot, inertial);
   ws.lambda = RankRevealingQr(jacobian.transpose(), rank_tolerance).solve(ws.force - inertial);
+}
+
+/// The sparse path of solve_kinematics, kept across the times of an analysis. The rank pass
+/// (in the model's topological order, found once) chooses n independent rows of Phi_q. Their
+/// square matrix keeps its pattern while the same rows stay chosen, so the LU's ordering, and
+/// its pivots while they stay good, carry over from one Newton iteration and one time to the
+/// next. A Newton step solves that square system: the one step that zeroes the chosen rows'
+/// linear residual, the others' following from them. A constraint row that repeats others gets
+/// no multiplier (0): with redundant joints the reactions are one valid choice, not the
+/// minimum-norm one of the dense path.
+template <class Model>
+class SparseKinematics {
+ public:
+  explicit SparseKinematics(const Model& model)
+      : model_(model), order_(row_order(model)), n_(model.num_velocities()) {}
+
+  /// Positions (Newton from ws.q), velocities, accelerations and multipliers at time ws.t.
+  void solve(Workspace<Model>& ws, const KinematicSettings& s) {
+    solve_positions(ws, s);
+    solve_rates(ws);
+  }
+
+ private:
+  const Model& model_;
+  RowOrder order_;
+  int n_;
+  SparseRows rows_;             // Phi_q at the last evaluate_constraints
+  std::vector<int> kept_;       // the chosen rows (row k of the square matrix is row kept_[k])
+  std::vector<int> dependent_;  // the others, from the last rank pass
+  std::vector<int> slot_;       // for each entry of rows_, its place in values_ (-1: not kept)
+  std::vector<int> starts_, row_indices_;  // the square matrix's pattern, by columns
+  std::vector<double> values_;
+  SparseLu lu_;
+  bool analyzed_ = false;
+
+  /// The rank pass on rows_: false if fewer than n rows are independent. A new choice of rows
+  /// builds the square matrix's pattern and the LU's ordering afresh.
+  bool choose_rows() {
+    const std::vector<char> independent = independent_rows(order_, rows_, rank_tolerance);
+    std::vector<int> kept;
+    dependent_.clear();
+    for (int r = 0; r < rows_.num_rows(); ++r) (independent[r] ? kept : dependent_).push_back(r);
+    if (static_cast<int>(kept.size()) < n_) return false;
+    if (analyzed_ && kept == kept_) return true;
+    kept_ = std::move(kept);
+    starts_.assign(static_cast<std::size_t>(n_) + 1, 0);
+    for (const int r : kept_)
+      for (int e = rows_.starts[r]; e < rows_.starts[r + 1]; ++e) ++starts_[rows_.columns[e] + 1];
+    for (int j = 0; j < n_; ++j) starts_[j + 1] += starts_[j];
+    row_indices_.resize(static_cast<std::size_t>(starts_[n_]));
+    values_.resize(row_indices_.size());
+    slot_.assign(rows_.columns.size(), -1);
+    std::vector<int> next(starts_.begin(), starts_.end() - 1);
+    for (int k = 0; k < n_; ++k)
+      for (int e = rows_.starts[kept_[k]]; e < rows_.starts[kept_[k] + 1]; ++e) {
+        slot_[e] = next[rows_.columns[e]]++;
+        row_indices_[slot_[e]] = k;
+      }
+    if (n_ > 0) lu_.analyze(n_, starts_, row_indices_);
+    analyzed_ = true;
+    return true;
+  }
+
+  /// Factorizes the chosen rows of rows_; false if they are singular.
+  bool factorize() {
+    if (n_ == 0) return true;
+    for (std::size_t e = 0; e < slot_.size(); ++e)
+      if (slot_[e] >= 0) values_[slot_[e]] = rows_.values[e];
+    return lu_.factorize(values_, SparseLu::independent_rows_ratio);
+  }
+
+  /// Factors of Phi_q at the last evaluate_constraints: the rows chosen before while they stay
+  /// regular, else a new choice. False if Phi_q has fewer than n independent rows.
+  bool factorize_here(const Workspace<Model>& ws) {
+    rows_ = sparse_jacobian(model_, ws);
+    if (analyzed_ && factorize()) return true;
+    return choose_rows() && factorize();
+  }
+
+  void solve_positions(Workspace<Model>& ws, const KinematicSettings& s) {
+    using Space = typename Model::Space;
+    constexpr int nq = Model::nq, nv = Model::nv;
+    const int m = model_.num_equations();
+    auto residual_norm = [&] {
+      update_frames(model_, ws);
+      evaluate_constraints(model_, ws);
+      return m > 0 ? ws.phi.cwiseAbs().maxCoeff() : 0.0;
+    };
+    double norm = residual_norm();
+    int iteration = 0;
+    for (; iteration < s.max_iterations && norm > s.tolerance && std::isfinite(norm); ++iteration) {
+      if (!factorize_here(ws)) throw_lock_up(model_, ws.t, dependent_);
+      Eigen::VectorXd step(n_);
+      for (int k = 0; k < n_; ++k) step[k] = -ws.phi[kept_[k]];
+      lu_.solve_in_place(step);
+      // Halve the step until the residual decreases: a damped Newton method.
+      const Eigen::VectorXd start = ws.q;
+      double fraction = 1.0, trial = norm;
+      for (int halving = 0; halving < 30; ++halving, fraction *= 0.5) {
+        for (int b = 0; b < model_.num_bodies(); ++b)
+          Space::integrate(start.template segment<nq>(b * nq),
+                           fraction * step.template segment<nv>(b * nv),
+                           ws.q.template segment<nq>(b * nq));
+        trial = residual_norm();
+        if (trial < norm) break;
+      }
+      norm = trial;
+    }
+    if (!(norm <= s.tolerance)) {
+      Eigen::Index row = 0;
+      const double worst = m > 0 ? ws.phi.cwiseAbs().maxCoeff(&row) : 0.0;
+      const std::string joint = m > 0 ? model_.constraint_name(static_cast<int>(row)) : "";
+      throw AssemblyError(joint, "at t = " + to_text(ws.t) +
+                                     " s the constraints and drivers could not be met after " +
+                                     std::to_string(iteration) +
+                                     " Newton iterations; largest residual " + to_text(worst) +
+                                     " at joint '" + joint + "'");
+    }
+  }
+
+  /// Velocities, accelerations and multipliers at solved positions (constraints evaluated).
+  void solve_rates(Workspace<Model>& ws) {
+    rows_ = sparse_jacobian(model_, ws);
+    if (!choose_rows()) throw_lock_up(model_, ws.t, dependent_);  // rank checked at every time
+    if (!factorize()) throw_lock_up(model_, ws.t, {});
+    Eigen::VectorXd v(n_), vdot(n_), multipliers(n_);
+    for (int k = 0; k < n_; ++k) v[k] = -ws.phi_t[kept_[k]];
+    if (n_ > 0) lu_.solve_in_place(v);  // Phi_q v = -Phi_t
+    ws.v = v;
+    update_frames(model_, ws);
+    evaluate_constraints(model_, ws);
+    initialize_states(model_, ws);
+    evaluate_forces(model_, ws);
+    evaluate_gamma(model_, ws);
+    for (int k = 0; k < n_; ++k) vdot[k] = ws.gamma[kept_[k]];
+    if (n_ > 0) lu_.solve_in_place(vdot);  // Phi_q v' = gamma
+    ws.vdot = vdot;
+    mass_times(model_, ws.vdot, multipliers);
+    multipliers = ws.force - multipliers;
+    if (n_ > 0) lu_.solve_transposed_in_place(multipliers);  // Phi_q^T lambda = Q - M v'
+    ws.lambda.setZero();
+    for (int k = 0; k < n_; ++k) ws.lambda[kept_[k]] = multipliers[k];
+    if (!v.allFinite() || !vdot.allFinite() || !multipliers.allFinite())
+      throw_lock_up(model_, ws.t, {});
+  }
+};
+}  // namespace detail
+
+/// Solves positions, velocities, accelerations and multipliers at time ws.t, from a nearby
+/// configuration in ws.q. Throws AssemblyError at a lock-up (Newton fails, or Phi_q loses
+/// rank), naming the time and the equations that became dependent.
+template <class Model>
+void solve_kinematics(const Model& model, Workspace<Model>& ws, const KinematicSettings& s = {}) {
+  if (detail::sparse_kinematics(model, s.linear_solver))
+    detail::SparseKinematics<Model>(model).solve(ws, s);
+  else
+    detail::solve_kinematics_dense(model, ws, s);
 }
 
 namespace detail {
@@ -269,7 +371,15 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
   start.linear_solver = s.linear_solver;
   assemble_positions(model, ws, start);
   require_fully_driven(model, ws, s.linear_solver);
-  solve_kinematics(model, ws, s);
+  std::optional<detail::SparseKinematics<Model>> sparse;
+  if (detail::sparse_kinematics(model, s.linear_solver)) sparse.emplace(model);
+  const auto solve = [&] {
+    if (sparse)
+      sparse->solve(ws, s);
+    else
+      detail::solve_kinematics_dense(model, ws, s);
+  };
+  solve();
   record(static_cast<const Workspace<Model>&>(ws));
 
   // One step from the solved state in ws to time `to`; false (ws unchanged) if it fails.
@@ -282,12 +392,12 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
                               ws.q.template segment<nq>(b * nq));
     ws.t = to;
     try {
-      solve_kinematics(model, ws, s);
+      solve();
       return true;
     } catch (const AssemblyError&) {
       ws.t = from;
       ws.q = q;
-      solve_kinematics(model, ws, s);  // restores the solved state's v, v' and lambda
+      solve();  // restores the solved state's v, v' and lambda
       return false;
     }
   };
