@@ -218,6 +218,13 @@ TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or
                           l.model, ws, 1.0, 0.1, [](const auto&) {}, with_solver(solver)),
                       Catch::Contains("over-driven") && Catch::Contains("motor'"));
   }
+  SECTION("an output interval too short to count its outputs") {
+    four_bar::Linkage l = four_bar::build();
+    odyn::Workspace<four_bar::Model> ws(l.model);
+    CHECK_THROWS_WITH(odyn::kinematic_analysis(
+                          l.model, ws, 1.0, 1e-300, [](const auto&) {}, with_solver(solver)),
+                      Catch::Contains("asks for 1e+300 outputs"));
+  }
 }
 
 TEST_CASE("A crank driven past its dead centre locks up, named with its time", "[kinematics]") {

@@ -118,6 +118,8 @@ def test_bad_settings_are_refused_by_name():
         odyn.kinematics(slider_crank(1.0), max_halvings=-1)
     with pytest.raises(odyn.SceneError, match="linear_solver"):
         odyn.kinematics(slider_crank(1.0), linear_solver="umfpack")
+    with pytest.raises(odyn.ModelError, match="asks for 1e\\+300 outputs"):
+        odyn.kinematics(slider_crank(1.0), output_interval=1e-300)
 
 
 def driven_chain(links, driven=True):

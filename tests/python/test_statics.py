@@ -242,6 +242,8 @@ def test_a_slowly_turned_crank_needs_the_virtual_work_torque():
     assert all(row["force_residual"] < 1e-12 for row in result.statics)
     with pytest.raises(odyn.SceneError, match="max_halvings"):
         odyn.quasi_statics(m, max_halvings=-1)
+    with pytest.raises(odyn.ModelError, match="quasi-static.*asks for 1e\\+300 outputs"):
+        odyn.quasi_statics(m, output_interval=1e-300)
 
 
 def test_a_scene_names_a_quasi_static_analysis_and_the_command_line_runs_it(tmp_path, capsys):

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "odyn/analysis/assembly.hpp"
+#include "odyn/analysis/output_times.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
 #include "odyn/linalg/linear_solver.hpp"
@@ -366,6 +367,7 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
   if (!(t_end >= ws.t) || !std::isfinite(t_end))
     throw ModelError("kinematic analysis", "expected an end time >= the start time " +
                                                to_text(ws.t) + ", got " + to_text(t_end));
+  detail::output_count("kinematic analysis", ws.t, t_end, interval);  // refuses a tiny interval
   AssemblySettings start;
   start.tolerance = s.tolerance;
   start.linear_solver = s.linear_solver;
@@ -401,13 +403,9 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
       return false;
     }
   };
-  auto advance = [&](double to) {
-    double h = to - ws.t;
-    int halvings = 0;
-    while (ws.t < to) {
-      const double next = to - ws.t <= h * (1.0 + 1e-9) ? to : ws.t + h;
-      if (step(next)) continue;
-      if (++halvings > s.max_halvings) {
+  detail::step_through_outputs(
+      "kinematic analysis", ws.t, t_end, interval, s.max_halvings, step,
+      [&](double h, double) {
         const RedundantEquation weakest = detail::weakest_equation(model, ws, s.linear_solver);
         throw AssemblyError(weakest.joint,
                             "the mechanism locks up after t = " + to_text(ws.t) +
@@ -416,20 +414,8 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
                                 " s step later; the equation nearest to depending "
                                 "on the others there is " +
                                 weakest.text());
-      }
-      h *= 0.5;
-    }
-  };
-  const double t0 = ws.t;
-  const auto outputs = static_cast<long>(std::floor((t_end - t0) / interval * (1.0 + 1e-12)));
-  for (long k = 1; k <= outputs; ++k) {
-    advance(t0 + static_cast<double>(k) * interval);
-    record(static_cast<const Workspace<Model>&>(ws));
-  }
-  if (t_end - ws.t > 1e-12 * std::max(1.0, std::abs(t_end))) {
-    advance(t_end);
-    record(static_cast<const Workspace<Model>&>(ws));
-  }
+      },
+      [&] { record(static_cast<const Workspace<Model>&>(ws)); });
 }
 
 }  // namespace odyn

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <vector>
 
+#include "odyn/analysis/output_times.hpp"
 #include "odyn/analysis/statics.hpp"
 
 namespace odyn {
@@ -34,6 +35,7 @@ void quasi_static_analysis(const Model& model, Workspace<Model>& ws, double t_en
   if (!(t_end >= ws.t) || !std::isfinite(t_end))
     throw ModelError("quasi-static analysis", "expected an end time >= the start time " +
                                                   to_text(ws.t) + ", got " + to_text(t_end));
+  detail::output_count("quasi-static analysis", ws.t, t_end, interval);  // refuses a tiny interval
   if (!(s.max_halvings >= 0))
     throw ModelError("quasi-static analysis",
                      "max_halvings must be 0 or more, got " + std::to_string(s.max_halvings));
@@ -55,32 +57,16 @@ void quasi_static_analysis(const Model& model, Workspace<Model>& ws, double t_en
       return false;
     }
   };
-  const auto advance = [&](double to) {
-    double h = to - ws.t;
-    int halvings = 0;
-    while (ws.t < to) {
-      const double next = to - ws.t <= h * (1.0 + 1e-9) ? to : ws.t + h;
-      if (step(next)) continue;
-      if (++halvings > s.max_halvings) {
+  detail::step_through_outputs(
+      "quasi-static analysis", ws.t, t_end, interval, s.max_halvings, step,
+      [&](double h, double next) {
         const double reached = ws.t;
         ws.t = next;
         static_equilibrium(model, ws, s.statics);  // throws the reason
         throw SolverError(
             reached, "no static equilibrium found a " + to_text(h) + " s step after this time");
-      }
-      h *= 0.5;
-    }
-  };
-  const double t0 = ws.t;
-  const auto outputs = static_cast<long>(std::floor((t_end - t0) / interval * (1.0 + 1e-12)));
-  for (long k = 1; k <= outputs; ++k) {
-    advance(t0 + static_cast<double>(k) * interval);
-    record(static_cast<const Workspace<Model>&>(ws), last);
-  }
-  if (t_end - ws.t > 1e-12 * std::max(1.0, std::abs(t_end))) {
-    advance(t_end);
-    record(static_cast<const Workspace<Model>&>(ws), last);
-  }
+      },
+      [&] { record(static_cast<const Workspace<Model>&>(ws), last); });
 }
 
 }  // namespace odyn
