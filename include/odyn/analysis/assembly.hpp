@@ -154,11 +154,14 @@ bool sparse_assembly(const Model& model, const AssemblySettings& s) {
 
 /// The rows of Phi_q (at the blocks of the last evaluate_constraints) that depend on others:
 /// by a rank-revealing QR of the dense matrix for small models, and for large ones (past
-/// dense_assembly_limit) by sparse elimination in the model's topological order (see
-/// independent_rows), which names rows of the joints that close loops.
+/// dense_assembly_limit, or as `solver` says) by sparse elimination in the model's
+/// topological order (see independent_rows), which names rows of the joints that close loops.
 template <class Model>
-std::vector<int> dependent_rows(const Model& model, const Workspace<Model>& ws) {
-  if (!sparse_assembly(model, AssemblySettings{})) return dependent_rows(dense_jacobian(model, ws));
+std::vector<int> dependent_rows(const Model& model, const Workspace<Model>& ws,
+                                LinearSolver solver = LinearSolver::automatic) {
+  AssemblySettings s;
+  s.linear_solver = solver;
+  if (!sparse_assembly(model, s)) return dependent_rows(dense_jacobian(model, ws));
   const std::vector<char> independent =
       independent_rows(model, sparse_jacobian(model, ws), rank_tolerance);
   std::vector<int> rows;

@@ -76,20 +76,6 @@ bool sparse_kinematics(const Model& model, LinearSolver solver) {
   return sparse_assembly(model, s);
 }
 
-/// The rows of Phi_q at the last evaluate_constraints that depend on others (see
-/// dependent_rows in analysis/assembly.hpp), by the chosen linear algebra.
-template <class Model>
-std::vector<int> dependent_rows(const Model& model, const Workspace<Model>& ws,
-                                LinearSolver solver) {
-  if (!sparse_kinematics(model, solver)) return dependent_rows(dense_jacobian(model, ws));
-  const std::vector<char> independent =
-      independent_rows(model, sparse_jacobian(model, ws), rank_tolerance);
-  std::vector<int> rows;
-  for (int r = 0; r < static_cast<int>(independent.size()); ++r)
-    if (!independent[r]) rows.push_back(r);
-  return rows;
-}
-
 template <class Model>
 [[noreturn]] void throw_lock_up(const Model& model, double t, const std::vector<int>& dependent) {
   std::string rows;
