@@ -26,8 +26,9 @@
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
                    generalized-alpha when a step is given without rtol and atol;
                    "type": "dynamic" (the default), "kinematic" (odyn.kinematics: t_end,
-                   output_interval, max_iterations, linear_solver), "static" or "modes" (odyn.statics,
-                   odyn.modes: max_iterations, coordinates "absolute" or "joint"),
+                   output_interval, max_iterations, linear_solver), "static" or "modes"
+                   (odyn.statics, odyn.modes: max_iterations, coordinates "absolute" or
+                   "joint"),
                    "quasi_static" (odyn.quasi_statics: t_end, output_interval,
                    max_iterations, coordinates, max_halvings) or "linear" (odyn.linearize:
                    "inputs": {name: {"body": ..., "force": ..., "torque": ...}}, "outputs":
