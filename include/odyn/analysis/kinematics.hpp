@@ -231,7 +231,7 @@ class SparseKinematics {
   /// Factors of Phi_q at the last evaluate_constraints: the rows chosen before while they stay
   /// regular, else a new choice. False if Phi_q has fewer than n independent rows.
   bool factorize_here(const Workspace<Model>& ws) {
-    rows_ = sparse_jacobian(model_, ws);
+    sparse_jacobian(model_, ws, rows_);
     if (analyzed_ && factorize()) return true;
     return choose_rows() && factorize();
   }
@@ -279,7 +279,7 @@ class SparseKinematics {
 
   /// Velocities, accelerations and multipliers at solved positions (constraints evaluated).
   void solve_rates(Workspace<Model>& ws) {
-    rows_ = sparse_jacobian(model_, ws);
+    sparse_jacobian(model_, ws, rows_);
     if (!choose_rows()) throw_lock_up(model_, ws.t, dependent_);  // rank checked at every time
     if (!factorize()) throw_lock_up(model_, ws.t, {});
     Eigen::VectorXd v(n_), vdot(n_), multipliers(n_);

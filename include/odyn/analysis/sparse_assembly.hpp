@@ -39,12 +39,12 @@ struct SparseRows {
   int num_rows() const { return static_cast<int>(starts.size()) - 1; }
 };
 
-/// Phi_q from the Jacobian blocks of the last evaluate_constraints.
+/// Phi_q from the Jacobian blocks of the last evaluate_constraints, into `rows`, whose vectors
+/// keep their memory from one call to the next (a kinematic analysis's Newton iterations).
 template <class Model>
-SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
+void sparse_jacobian(const Model& model, const Workspace<Model>& ws, SparseRows& rows) {
   constexpr int nv = Model::nv;
   const int m = model.num_equations();
-  SparseRows rows;
   rows.num_columns = model.num_velocities();
   rows.starts.assign(static_cast<std::size_t>(m) + 1, 0);
   for_each_jacobian_block(model, ws, [&](int row, int, const auto& block) {
@@ -62,6 +62,12 @@ SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
         rows.values[k] = block(i, j);
       }
   });
+}
+
+template <class Model>
+SparseRows sparse_jacobian(const Model& model, const Workspace<Model>& ws) {
+  SparseRows rows;
+  sparse_jacobian(model, ws, rows);
   return rows;
 }
 
