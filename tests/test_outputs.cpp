@@ -7,7 +7,9 @@
 // (a bushing's outputs are tested in test_bushing.cpp, on its damped oscillator);
 // - points on a spinning top and a planar pendulum: velocity and acceleration against central
 //   differences of the recorded positions and velocities;
-// - outputs by name, and the error naming the element's outputs for an unknown one.
+// - outputs by name, and the error naming the element's outputs for an unknown one;
+// - the output times of a run: every interval, then t_end when it falls between two (a body
+//   falling freely, against its parabola), with every integrator.
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -206,6 +208,43 @@ TEST_CASE("Outputs by name; an unknown output names the element's outputs", "[ou
                     Catch::Contains("reports none"));
   static_assert(odyn::HasOutputs<sp::Tsda> && odyn::HasOutputs<sp::Rsda> &&
                 odyn::HasOutputs<pl::Bushing> && !odyn::HasOutputs<sp::Spherical>);
+}
+
+TEST_CASE("A run ends at t_end, also between two outputs, with every integrator", "[outputs]") {
+  // A free body falls from rest: z = -g t^2 / 2, which every integrator follows closely (bdf
+  // starts at order 1, which is not exact for a parabola; its error control holds it).
+  const double g = 9.81;
+  sp::DefaultModel model;
+  model.add_body({.name = "stone", .mass = 1.0, .inertia = sp::Body::principal(0.1, 0.1, 0.1)});
+  model.add(sp::Gravity("gravity", Vector3d(0.0, 0.0, -g)));
+  const std::string integrator = GENERATE(as<std::string>{}, "generalized-alpha", "hht", "dop853",
+                                          "dopri5", "adams", "bdf", "auto");
+  const auto times_of_run = [&](double t_end, double output_interval) {
+    odyn::DynamicsSettings settings = tight_run(t_end, output_interval);
+    settings.integrator = integrator;
+    settings.step = 1e-3;
+    odyn::Workspace<sp::DefaultModel> ws(model);
+    std::vector<double> times;
+    double worst = 0.0;
+    odyn::simulate(model, ws, settings, [&](const auto& w) {
+      times.push_back(w.t);
+      worst = std::max(worst, std::abs(w.q[2] + 0.5 * g * w.t * w.t));
+    });
+    CHECK(ws.t == t_end);
+    CHECK(worst < 1e-10);
+    return times;
+  };
+  INFO(integrator);
+  const std::vector<double> between = times_of_run(0.015, 0.01);
+  REQUIRE(between.size() == 3);
+  CHECK(between[1] == Approx(0.01).epsilon(1e-14));
+  CHECK(between[2] == 0.015);
+  // An interval longer than the run: its start and its end.
+  CHECK(times_of_run(0.015, 0.5) == std::vector<double>{0.0, 0.015});
+  // A whole number of intervals: no extra output for the rounding of 0.1 / 0.01.
+  const std::vector<double> whole = times_of_run(0.1, 0.01);
+  REQUIRE(whole.size() == 11);
+  CHECK(whole.back() == Approx(0.1).epsilon(1e-14));
 }
 
 }  // namespace test_outputs

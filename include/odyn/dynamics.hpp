@@ -18,6 +18,7 @@
 
 #include "odyn/analysis/assembly.hpp"
 #include "odyn/analysis/massless_motion.hpp"
+#include "odyn/analysis/output_times.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/analysis/watches.hpp"
 #include "odyn/analysis/zero_crossing.hpp"
@@ -333,15 +334,17 @@ void advance_to(const Model& model, Workspace<Model>& ws, Integrator& integrator
   }
 }
 
-/// The output times of a run, t0 + k dt for k = 1 .. count (t0 itself is recorded before the
-/// first step), and the next one to hand over: a run that changes integrator midway goes on
-/// from there.
+/// The output times of a run, t0 + k dt for k = 1 .. count - 1 and then `last` (t0 itself is
+/// recorded before the first step), and the next one to hand over: a run that changes
+/// integrator midway goes on from there. `last` is t0 + count dt, or t_end when it falls
+/// between two outputs, so that the run ends where it was asked to.
 struct OutputGrid {
   double t0 = 0.0;
   double interval = 1e-3;
   long count = 0;
   long next = 1;
-  double time(long k) const { return t0 + static_cast<double>(k) * interval; }
+  double last = 0.0;
+  double time(long k) const { return k == count ? last : t0 + static_cast<double>(k) * interval; }
   bool done() const { return next > count; }
 };
 
@@ -493,6 +496,10 @@ RunSummary start_run(const Model& model, Workspace<Model>& ws, const DynamicsSet
   if (!(s.rtol > 0.0) || !(s.atol > 0.0))
     throw ModelError("dynamics", "rtol and atol must be positive (got rtol " + to_text(s.rtol) +
                                      ", atol " + to_text(s.atol) + ")");
+  if (!(s.rtol < 1.0))
+    throw ModelError("dynamics", "rtol " + to_text(s.rtol) +
+                                     " is a relative error of 100% or more, which controls "
+                                     "nothing; give a fraction below 1 (1e-6 by default)");
   RunSummary summary;
   AssemblySettings assembly = s.assembly;
   assembly.linear_solver = s.linear_solver;
@@ -528,10 +535,17 @@ inline void note_tolerance_floor(const DynamicsSettings& s, bool adaptive, RunSu
                           " (100 machine epsilons): a smaller one only adds steps and rounding"});
 }
 
+/// The run's output times: every output_interval from t0 (a count too large to hold is refused
+/// by name), and t_end when it falls between two of them.
 inline OutputGrid output_grid(const DynamicsSettings& s, double t0) {
+  const long whole = output_count("dynamics", t0, s.t_end, s.output_interval);
+  const double whole_end = t0 + static_cast<double>(whole) * s.output_interval;
+  const bool partial = s.t_end - whole_end > 1e-12 * std::max(1.0, std::abs(s.t_end));
   return {.t0 = t0,
           .interval = s.output_interval,
-          .count = static_cast<long>(std::floor((s.t_end - t0) / s.output_interval + 1e-9))};
+          .count = whole + (partial ? 1 : 0),
+          .next = 1,
+          .last = partial ? s.t_end : whole_end};
 }
 
 /// Hands the workspace to the observer at an output, with the blocks of every element up to

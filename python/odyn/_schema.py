@@ -50,7 +50,10 @@ def check_number(x: Any, where: str, *, minimum: Optional[float] = None,
                  positive: bool = False) -> float:
     if not _is_number(x):
         fail(where, f"expected a number, got {_describe(x)}")
-    value = float(x)
+    try:
+        value = float(x)
+    except OverflowError:  # an integer beyond a double's range
+        fail(where, f"expected a finite number, got an integer of {len(str(abs(int(x))))} digits")
     if not math.isfinite(value):
         fail(where, f"expected a finite number, got {value}")
     if positive and not value > 0.0:
@@ -58,6 +61,23 @@ def check_number(x: Any, where: str, *, minimum: Optional[float] = None,
     if minimum is not None and value < minimum:
         fail(where, f"expected a number >= {minimum:g}, got {value:g}")
     return value
+
+
+def check_tolerance(x: Any, where: str, *, relative: bool = False) -> float:
+    """A positive tolerance; a relative one (rtol, newton_rtol) also below 1, since an error of
+    100% or more of the value controls nothing."""
+    value = check_number(x, where, positive=True)
+    if relative and not value < 1.0:
+        fail(where, f"a relative tolerance of {value:g} (100% or more) controls nothing; give a "
+             "fraction below 1, such as 1e-6")
+    return value
+
+
+def check_count(x: Any, where: str, least: int) -> int:
+    """A whole number (a Python or NumPy integer, not a bool) of at least `least`."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < least:
+        fail(where, f"expected a whole number of at least {least}, got {_describe(x)}")
+    return int(x)
 
 
 def check_vector(x: Any, where: str, size: int = 3, *, nonzero: bool = False) -> List[float]:
@@ -74,6 +94,11 @@ def check_vector(x: Any, where: str, size: int = 3, *, nonzero: bool = False) ->
 def check_name(x: Any, where: str) -> str:
     if not isinstance(x, str) or not x.strip():
         fail(where, f"expected a non-empty name (a string), got {_describe(x)}")
+    try:
+        x.encode("utf-8")
+    except UnicodeEncodeError:  # a lone surrogate ("\ud800" in JSON): no text the core can hold
+        fail(where, f"the name {_describe(x)} holds a lone surrogate, which is not text; use "
+             "characters that UTF-8 can encode")
     return x
 
 

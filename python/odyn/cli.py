@@ -208,12 +208,27 @@ def _settings(args: argparse.Namespace, scene: Scene, kind: str) -> dict:
     return settings
 
 
+def _check_output_path(path: str) -> None:
+    """Refuses, before any work, an --out that could not be written at the end."""
+    if not path.endswith((".csv", ".npz")):
+        raise ValueError(f"--out {path}: expected a .csv or .npz file name")
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise ValueError(f"--out {path}: is a directory; give a file name")
+    if not os.path.isdir(folder):
+        raise ValueError(f"--out {path}: the folder {folder} does not exist; create it first")
+    if not os.access(folder, os.W_OK | os.X_OK) or (os.path.exists(path)
+                                                    and not os.access(path, os.W_OK)):
+        raise ValueError(f"--out {path}: not writable here (permission denied); choose another "
+                         "place")
+
+
 def _run(args: argparse.Namespace) -> int:
     scene = load(args.scene)
     kind = args.analysis or scene.analysis_type
     settings = _settings(args, scene, kind)
-    if args.out and not args.out.endswith((".csv", ".npz")):
-        raise ValueError(f"--out {args.out}: expected a .csv or .npz file name")
+    if args.out:
+        _check_output_path(args.out)
     if kind not in TIMED:
         drawn = [o for o, v in (("--plot", args.plot), ("--figures", args.figures),
                                 ("--gif", None if kind == "modes" else args.gif))
@@ -236,6 +251,8 @@ def _run(args: argparse.Namespace) -> int:
         partial = getattr(e, "result", None)
         if partial is not None and args.out and len(partial):
             write_table(scene.columns(partial), args.out)
+            print(f"odyn: the {len(partial)} rows before the error, to t = {partial.t[-1]:g} s, "
+                  f"were written to {args.out}", file=sys.stderr)
         raise
     finally:
         progress.close()

@@ -8,7 +8,7 @@ from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tup
 import numpy as np
 
 from . import _core
-from ._schema import SceneError, check_choice, check_number
+from ._schema import SceneError, check_choice, check_count, check_number, check_tolerance
 from .model import BaseModel
 
 #: Integrators whose step is fixed unless `adaptive` (error control) is on.
@@ -423,6 +423,10 @@ class Result:
         return f"<odyn.Result: {len(self.t)} outputs, t = 0 .. {end} s{note}>"
 
 
+#: The tolerances of simulate() besides rtol and atol: positive, newton_rtol below 1 too.
+RUN_TOLERANCES = ("newton_rtol", "newton_atol", "constraint_tolerance", "projection_tolerance")
+
+
 def _settings(step: float, t_end: float, output_interval: float, integrator: str,
               rho_inf: float, rtol: Optional[float], atol: Optional[float],
               max_step: Optional[float], adaptive: Optional[bool], **extra: Any) -> Dict[str, Any]:
@@ -436,7 +440,9 @@ def _settings(step: float, t_end: float, output_interval: float, integrator: str
         "integrator": check_choice(integrator, "integrator", list(names)),
         "rho_inf": check_number(rho_inf, "rho_inf", minimum=0.0),
     }
-    for key, value in (("rtol", rtol), ("atol", atol), ("max_step", max_step)):
+    if rtol is not None:
+        settings["rtol"] = check_tolerance(rtol, "rtol", relative=True)
+    for key, value in (("atol", atol), ("max_step", max_step)):
         if value is not None:
             settings[key] = check_number(value, key, positive=True)
     if adaptive is not None and not isinstance(adaptive, bool):
@@ -448,8 +454,13 @@ def _settings(step: float, t_end: float, output_interval: float, integrator: str
         raise SceneError(f"adaptive: applies to {' and '.join(ADAPTIVE_OPTIONAL)}; {integrator} "
                          "chooses its steps itself (leave 'adaptive' out)")
     for key, value in extra.items():
-        if value is not None:
-            settings[key] = value
+        if value is None:
+            continue
+        if key in RUN_TOLERANCES:
+            value = check_tolerance(value, key, relative=key == "newton_rtol")
+        elif key == "max_iterations":
+            value = check_count(value, key, 1)
+        settings[key] = value
     return settings
 
 

@@ -26,7 +26,8 @@
                    odyn.integrators(); left out, it is simulate()'s choice: auto, or
                    generalized-alpha when a step is given without rtol and atol;
                    "type": "dynamic" (the default), "kinematic" (odyn.kinematics: t_end,
-                   output_interval, max_iterations, linear_solver), "static" or "modes"
+                   output_interval, max_iterations, linear_solver,
+                   coordinates "absolute" or "joint"), "static" or "modes"
                    (odyn.statics, odyn.modes: max_iterations, coordinates "absolute" or
                    "joint"),
                    "quasi_static" (odyn.quasi_statics: t_end, output_interval,
@@ -61,7 +62,7 @@ import numpy as np
 
 from . import _schema, modules
 from ._schema import (SceneError, check_choice, check_flag, check_keys, check_name,
-                      check_number, fail)
+                      check_number, check_tolerance, fail)
 from .model import BaseModel, Model, new_model
 from .kinematics import kinematics
 from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
@@ -99,7 +100,7 @@ ANALYSIS_OPTIONAL = ("type", "integrator", "rho_inf", "step", "rtol", "atol", "m
 #: output_interval (which only the analyses in TIMED use).
 ANALYSES: Dict[str, Tuple[str, ...]] = {
     "dynamic": ANALYSIS_OPTIONAL[1:ANALYSIS_OPTIONAL.index("max_halvings")],
-    "kinematic": ("max_iterations", "linear_solver"),
+    "kinematic": ("max_iterations", "linear_solver", "coordinates"),
     "quasi_static": ("max_iterations", "coordinates", "max_halvings"),
     "static": ("max_iterations", "coordinates"),
     "modes": ("max_iterations", "coordinates"),
@@ -129,6 +130,10 @@ class Scene:
                  outputs: Optional[List[Dict[str, Any]]] = None,
                  figures: Optional[List[Dict[str, Any]]] = None, description: str = "") -> None:
         self.model: BaseModel = model if model is not None else Model()
+        if analysis is not None and not isinstance(analysis, Mapping):  # 0, [], "", false
+            given = json.dumps(analysis) if _jsonable(analysis) else repr(analysis)
+            fail("analysis", f"expected an object of settings, got {given}; leave it out for "
+                 "the defaults")
         self.analysis: Dict[str, Any] = _check_analysis(dict(analysis or {}), "analysis")
         if "inputs" in self.analysis:  # a linear analysis's loads and outputs name the model's
             check_inputs(self.model, self.analysis["inputs"], "analysis.inputs")
@@ -167,9 +172,9 @@ class Scene:
                 if k in ANALYSES[kind] or k in ANALYSIS_DEFAULTS}
         if kind == "dynamic":
             return simulate(self.model, progress=progress, **kept)
+        kept = {k: v for k, v in kept.items() if k != "coordinates" or v != "auto"}
         if kind == "kinematic":
             return kinematics(self.model, progress=progress, **kept)
-        kept = {k: v for k, v in kept.items() if k != "coordinates" or v != "auto"}
         if kind == "quasi_static":
             return quasi_statics(self.model, progress=progress, **kept)
         kept = {k: v for k, v in kept.items() if k not in ANALYSIS_DEFAULTS}
@@ -290,6 +295,8 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                         not 1 <= d[key] <= 6:
                     fail(f"{where}.{key}", f"expected an integer from 1 to 6, got {d[key]!r}")
                 out[key] = d[key]
+            elif key in ("rtol", "newton_rtol"):
+                out[key] = check_tolerance(d[key], f"{where}.{key}", relative=True)
             else:
                 out[key] = check_number(d[key], f"{where}.{key}", positive=True)
     return out
@@ -481,6 +488,9 @@ def from_dict(d: Any, where: str = "") -> Scene:
     for key, value in (("outputs", outputs), ("figures", figures)):
         if not isinstance(value, list):
             fail(f"{prefix}{key}", f"expected a list, got {type(value).__name__}")
+    if d.get("analysis", {}) is None:
+        fail(f"{prefix}analysis", "expected an object of settings, got null; leave it out for "
+             "the defaults")
     return Scene(model, d.get("analysis", {}), outputs, figures, description)
 
 
@@ -508,12 +518,30 @@ def _jsonable(x: Any) -> bool:
         return False
 
 
+def _unique_keys(pairs: List[Tuple[str, Any]]) -> Dict[str, Any]:
+    """A JSON object's members, refusing a key given twice (json would keep the last)."""
+    d: Dict[str, Any] = {}
+    for key, value in pairs:
+        if key in d:
+            others = ", ".join(repr(k) for k, _ in pairs[:6]) + (", ..." if len(pairs) > 6 else "")
+            raise SceneError(f"the key {key!r} appears twice in one object (its keys: {others}); "
+                             "JSON would keep the last silently: remove one")
+        d[key] = value
+    return d
+
+
 def loads(text: str, source: str = "<string>") -> Scene:
     """A scene from JSON text."""
     try:
-        d = json.loads(text)  # NaN and Infinity parse, and the checks name their place
+        # NaN and Infinity parse, and the checks name their place.
+        d = json.loads(text, object_pairs_hook=_unique_keys)
+    except SceneError as e:
+        raise SceneError(f"{source}: {e}") from None
     except ValueError as e:  # json.JSONDecodeError included
         raise SceneError(f"{source}: not valid JSON: {e}") from None
+    except RecursionError:
+        raise SceneError(f"{source}: nested too deeply to read (thousands of levels of lists "
+                         "or objects); a scene needs a few") from None
     return from_dict(d)
 
 
@@ -524,6 +552,9 @@ def load(path: Union[str, os.PathLike]) -> Scene:
             text = f.read()
     except OSError as e:
         raise SceneError(f"{path}: cannot read: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise SceneError(f"{path}: not UTF-8 text (byte 0x{e.object[e.start]:02x} at offset "
+                         f"{e.start}); save the scene as UTF-8") from None
     try:
         return loads(text, str(path))
     except SceneError as e:
@@ -543,15 +574,26 @@ def save(scene: Union[Scene, BaseModel], path: Union[str, os.PathLike]) -> None:
 
 
 def write_table(table: Mapping[str, np.ndarray], path: Union[str, os.PathLike]) -> None:
-    """Writes columns as CSV (12 significant digits, like the C++ example) or .npz."""
+    """Writes columns as CSV (12 significant digits, like the C++ example) or .npz. The file
+    appears whole or not at all (written beside it, then renamed), so that an interrupted write
+    leaves no truncated table in its place."""
     path = os.fspath(path)
-    if path.endswith(".npz"):
-        np.savez(path, **{k: np.asarray(v) for k, v in table.items()})  # type: ignore[arg-type]
-        return
-    names = list(table)
-    data: Any = np.column_stack([np.asarray(table[n], dtype=float) for n in names]) if names else []
-    with open(path, "w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(names)
-        for row in data:
-            writer.writerow(["%.12g" % x for x in row])
+    partial = path + ".part"
+    try:
+        if path.endswith(".npz"):
+            with open(partial, "wb") as f:
+                np.savez(f, **{k: np.asarray(v) for k, v in table.items()})  # type: ignore
+        else:
+            names = list(table)
+            data: Any = (np.column_stack([np.asarray(table[n], dtype=float) for n in names])
+                         if names else [])
+            with open(partial, "w", newline="", encoding="utf-8") as f:
+                writer = csv.writer(f, lineterminator="\n")
+                writer.writerow(names)
+                for row in data:
+                    writer.writerow(["%.12g" % x for x in row])
+        os.replace(partial, path)
+    except BaseException:
+        if os.path.exists(partial):
+            os.remove(partial)
+        raise

@@ -114,6 +114,12 @@ class ExplicitRungeKutta {
     if (!(proposed_step_ > 0.0))
       throw ModelError(Method::name,
                        "the first step must be positive, got " + to_text(proposed_step_));
+    if (!(settings.projection_tolerance > 0.0) || settings.max_projection_iterations < 1)
+      throw ModelError(Method::name,
+                       "projection_tolerance must be positive and max_projection_iterations at "
+                       "least 1, got " +
+                           to_text(settings.projection_tolerance) + " and " +
+                           std::to_string(settings.max_projection_iterations));
     nq_total_ = coordinates_.num_positions();
     nv_total_ = coordinates_.num_velocities();
     m_ = coordinates_.num_equations();

@@ -86,6 +86,16 @@ class GeneralizedAlphaMethod {
                        "rtol, atol and the first step must be positive, got " +
                            to_text(control.rtol) + ", " + to_text(control.atol) + " and " +
                            to_text(proposed_step_));
+    if (!(settings.newton_rtol > 0.0) || !(settings.newton_atol > 0.0) ||
+        !(settings.constraint_tolerance > 0.0) || settings.max_iterations < 1 ||
+        settings.reuse_iterations < 0)
+      throw ModelError(settings.hht ? "hht" : "generalized-alpha",
+                       "newton_rtol, newton_atol and constraint_tolerance must be positive, "
+                       "max_iterations at least 1 and reuse_iterations at least 0; got " +
+                           to_text(settings.newton_rtol) + ", " + to_text(settings.newton_atol) +
+                           ", " + to_text(settings.constraint_tolerance) + ", " +
+                           std::to_string(settings.max_iterations) + " and " +
+                           std::to_string(settings.reuse_iterations));
     const double rho = settings.rho_inf;
     if (!(rho >= 0.0 && rho <= 1.0))
       throw ModelError("generalized-alpha", "rho_inf must lie in [0, 1], got " + to_text(rho));

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,10 @@ class Callable {
   const std::string& what() const { return what_; }
 
  private:
+  /// Throws the exception the function raised, noted (PEP 678) with the element whose function
+  /// raised it and, if finite, the time: its type, message and traceback stay the user's.
+  [[noreturn]] void rethrow_noted(double t) const;
+
   py::object function_;
   std::vector<FrameView<Space>> views_;
   std::string what_;  // "point force 'push'": names the element in errors
@@ -197,6 +202,25 @@ Callable<Space>::~Callable() {
 }
 
 template <class Space>
+void Callable<Space>::rethrow_noted(double t) const {
+  PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
+  PyErr_Fetch(&type, &value, &traceback);
+  PyErr_NormalizeException(&type, &value, &traceback);
+  if (value != nullptr) {
+    if (traceback != nullptr) PyException_SetTraceback(value, traceback);
+    const std::string note = "odyn: raised by the function of " + what_ +
+                             (std::isfinite(t) ? ", at t = " + to_text(t) + " s" : "");
+    PyObject* added = PyObject_CallMethod(value, "add_note", "s", note.c_str());
+    if (added != nullptr)
+      Py_DECREF(added);
+    else
+      PyErr_Clear();  // a Python without notes (before 3.11): the exception as it was
+  }
+  PyErr_Restore(type, value, traceback);
+  throw py::error_already_set();
+}
+
+template <class Space>
 py::object Callable<Space>::call_with_frames(double t, const typename Space::Frame* const* frames) {
   // Vectorcall with the argument slots on the stack: no tuple is built.
   std::array<PyObject*, 4> args{};  // slot 0 is scratch (PY_VECTORCALL_ARGUMENTS_OFFSET)
@@ -209,7 +233,7 @@ py::object Callable<Space>::call_with_frames(double t, const typename Space::Fra
   PyObject* result =
       PyObject_Vectorcall(function_.ptr(), args.data() + 1,
                           (1 + views_.size()) | PY_VECTORCALL_ARGUMENTS_OFFSET, nullptr);
-  if (!result) throw py::error_already_set();
+  if (!result) rethrow_noted(t);
   return py::reinterpret_steal<py::object>(result);
 }
 
@@ -225,7 +249,7 @@ py::object Callable<Space>::call_with_numbers(std::initializer_list<double> numb
   }
   PyObject* result = PyObject_Vectorcall(function_.ptr(), args.data() + 1,
                                          n | PY_VECTORCALL_ARGUMENTS_OFFSET, nullptr);
-  if (!result) throw py::error_already_set();
+  if (!result) rethrow_noted(std::numeric_limits<double>::quiet_NaN());
   return py::reinterpret_steal<py::object>(result);
 }
 
@@ -236,7 +260,12 @@ py::object Callable<Space>::call_with_vectors(double t, const double* x, const d
     std::copy(values, values + n, out.mutable_data());
     return out;
   };
-  return function_(t, array(x), array(y));
+  try {
+    return function_(t, array(x), array(y));
+  } catch (py::error_already_set& error) {
+    error.restore();
+    rethrow_noted(t);
+  }
 }
 
 }  // namespace odyn::python

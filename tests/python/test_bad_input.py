@@ -1,0 +1,242 @@
+"""Bad input that once slipped through (accepted silently, or answered with a traceback or a
+vague message): each kind gets a specific error naming the setting or the place, the bad value
+and what to do, through the Python API, scene files and the command line alike."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import odyn
+from conftest import ROOT
+from test_kinematics import slider_crank
+
+SCENE = ROOT / "examples" / "slider_crank_planar.json"
+
+
+def falling_stone():
+    m = odyn.Model()
+    m.add_body(name="stone", mass=1.0, inertia=[0.1, 0.1, 0.1])
+    m.add_gravity(name="gravity", acceleration=[0, 0, -9.81])
+    return m
+
+
+def scene_dict():
+    with open(SCENE) as f:
+        return json.load(f)
+
+
+# (kind, the run's keyword arguments, the words its error must hold)
+BAD_RUN_SETTINGS = [
+    ("a relative tolerance of 100% or more", {"rtol": 1e300}, ["rtol", "below 1"]),
+    ("rtol of exactly 1", {"rtol": 1.0}, ["rtol", "below 1"]),
+    ("a negative Newton tolerance", {"integrator": "generalized-alpha", "newton_rtol": -1e-9},
+     ["newton_rtol", "positive", "-1e-09"]),
+    ("a Newton rtol of 2", {"integrator": "generalized-alpha", "newton_rtol": 2.0},
+     ["newton_rtol", "below 1"]),
+    ("a zero constraint tolerance", {"integrator": "bdf", "constraint_tolerance": 0.0},
+     ["constraint_tolerance", "positive"]),
+    ("no Newton iterations", {"integrator": "generalized-alpha", "max_iterations": 0},
+     ["max_iterations", "at least 1"]),
+    ("a fractional iteration count", {"integrator": "generalized-alpha", "max_iterations": 2.5},
+     ["max_iterations", "whole number"]),
+    ("a negative projection tolerance", {"integrator": "dop853", "projection_tolerance": -1e-12},
+     ["projection_tolerance", "positive"]),
+    ("an output interval too short to count", {"output_interval": 1e-300},
+     ["1e-300", "give a longer interval"]),
+]
+
+
+@pytest.mark.parametrize("kind, settings, words", BAD_RUN_SETTINGS,
+                         ids=[case[0] for case in BAD_RUN_SETTINGS])
+def test_run_settings_are_refused_by_name(kind, settings, words):
+    with pytest.raises(odyn.ModelError) as error:
+        odyn.simulate(falling_stone(), t_end=0.01, **settings)
+    for word in words:
+        assert word in str(error.value), (kind, str(error.value))
+
+
+@pytest.mark.parametrize("integrator", ["generalized-alpha", "dop853", "bdf", "auto"])
+def test_a_run_ends_at_t_end_between_two_outputs(integrator):
+    # Once the run stopped at the last whole output (0.01 for t_end 0.015), and an interval
+    # longer than the run gave its first row alone. The stone falls z = -g t^2 / 2.
+    for t_end, interval, times in ((0.015, 0.01, [0.0, 0.01, 0.015]), (0.015, 0.5, [0.0, 0.015])):
+        r = odyn.simulate(falling_stone(), t_end=t_end, output_interval=interval,
+                          integrator=integrator, step=1e-3, rtol=1e-10, atol=1e-10)
+        np.testing.assert_allclose(r.t, times, rtol=1e-14, atol=0)
+        np.testing.assert_allclose(r.q[:, 2], -0.5 * 9.81 * r.t ** 2, rtol=0, atol=1e-9)
+
+
+# (kind, how the scene dict is spoiled, the words the error must hold)
+def _set(path, value):
+    def spoil(d):
+        target = d
+        for key in path[:-1]:
+            target = target[key]
+        target[path[-1]] = value
+    return spoil
+
+
+BAD_SCENES = [
+    ("analysis of 0", _set(["analysis"], 0), ["analysis", "expected an object", "leave it out"]),
+    ("analysis of null", _set(["analysis"], None), ["analysis", "null", "leave it out"]),
+    ("analysis of []", _set(["analysis"], []), ["analysis", "expected an object"]),
+    ("analysis of an empty string", _set(["analysis"], ""), ["analysis", "expected an object"]),
+    ("analysis of false", _set(["analysis"], False), ["analysis", "false"]),
+    ("analysis of [1]", _set(["analysis"], [1]), ["analysis", "[1]"]),
+    ("a huge integer for a mass", _set(["bodies", 0, "mass"], 10 ** 400),
+     ["bodies[0].mass", "finite number", "401 digits"]),
+    ("a lone surrogate in a name", _set(["bodies", 0, "name"], "crank\ud800"),
+     ["bodies[0].name", "lone surrogate"]),
+    ("a relative tolerance of 1e300", _set(["analysis", "rtol"], 1e300),
+     ["analysis.rtol", "below 1"]),
+]
+
+
+@pytest.mark.parametrize("kind, spoil, words", BAD_SCENES, ids=[case[0] for case in BAD_SCENES])
+def test_scenes_are_refused_with_the_place(kind, spoil, words, tmp_path):
+    d = scene_dict()
+    spoil(d)
+    with pytest.raises(odyn.SceneError) as error:
+        odyn.loads(json.dumps(d))
+    for word in words:
+        assert word in str(error.value), (kind, str(error.value))
+    # The command line says the same in one line, without a traceback.
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(d))  # a lone surrogate is written escaped, as a file would hold
+    run = subprocess.run([sys.executable, "-m", "odyn", "run", str(path)], capture_output=True,
+                         text=True)
+    assert run.returncode == 1, run.stderr
+    assert run.stderr.startswith("odyn: ") and run.stderr.count("\n") == 1, run.stderr
+    assert words[0] in run.stderr
+
+
+SCENE_TEXTS = [
+    ("a key given twice", lambda text: text.replace('"mass": 1.399', '"mass": 1.399, "mass": 2'),
+     ["'mass' appears twice", "remove one"]),
+    ("nesting thousands deep", lambda text: text[:-2] + ', "x": ' + "[" * 100000
+     + "]" * 100000 + "}", ["nested too deeply"]),
+]
+
+
+@pytest.mark.parametrize("kind, spoil, words", SCENE_TEXTS, ids=[case[0] for case in SCENE_TEXTS])
+def test_scene_texts_are_refused(kind, spoil, words, tmp_path):
+    text = spoil(SCENE.read_text().rstrip() + "\n")
+    with pytest.raises(odyn.SceneError) as error:
+        odyn.loads(text, "bad.json")
+    for word in words:
+        assert word in str(error.value), (kind, str(error.value))
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    run = subprocess.run([sys.executable, "-m", "odyn", "check", str(path)],
+                         capture_output=True, text=True)
+    assert run.returncode == 1 and "Traceback" not in run.stderr, run.stderr
+    assert words[0] in run.stderr
+
+
+def test_a_scene_file_that_is_not_utf8(tmp_path):
+    path = tmp_path / "latin1.json"
+    path.write_bytes(SCENE.read_bytes().replace(b'"crank"', b'"crank\xe9"', 1))
+    with pytest.raises(odyn.SceneError, match=r"latin1.json: not UTF-8 text \(byte 0xe9 at "
+                                              r"offset \d+\); save the scene as UTF-8"):
+        odyn.load(path)
+
+
+@pytest.mark.parametrize("out, words", [
+    ("missing/r.csv", ["does not exist", "create it first"]),
+    ("folder.csv", ["is a directory"]),
+    ("r.txt", ["expected a .csv or .npz"]),
+])
+def test_an_output_the_cli_could_not_write_is_refused_before_the_run(out, words, tmp_path):
+    (tmp_path / "folder.csv").mkdir()
+    # t_end 1e4 s: a run that started would take minutes, and the test's timeout stops it.
+    run = subprocess.run([sys.executable, "-m", "odyn", "run", str(SCENE), "--t-end", "1e4",
+                          "--out", out], capture_output=True, text=True, cwd=tmp_path,
+                         timeout=120)
+    assert run.returncode == 1, run.stderr
+    for word in words:
+        assert word in run.stderr, run.stderr
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")
+def test_an_unwritable_output_folder_is_refused_before_the_run(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        run = subprocess.run([sys.executable, "-m", "odyn", "run", str(SCENE), "--t-end", "1e4",
+                              "--out", str(locked / "r.csv")], capture_output=True, text=True,
+                             timeout=120)
+    finally:
+        locked.chmod(0o700)
+    assert run.returncode == 1 and "not writable" in run.stderr, run.stderr
+
+
+def test_a_failed_run_says_where_its_partial_table_went(tmp_path):
+    path = tmp_path / "locking.json"
+    # A slider-crank whose rod (0.06 m) is shorter than its crank (0.1 m), turned at 10 rad/s:
+    # it locks up where 0.1 sin(theta) = 0.06, at t = asin(0.6) / 10 = 0.0644 s.
+    odyn.save(odyn.Scene(slider_crank(10.0, rod=0.06), {"type": "kinematic", "t_end": 0.5,
+                                                       "output_interval": 0.005}), path)
+    run = subprocess.run([sys.executable, "-m", "odyn", "run", str(path), "--out", "r.csv"],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert run.returncode == 1, run.stderr
+    assert "locks up" in run.stderr
+    rows = (tmp_path / "r.csv").read_text().splitlines()[1:]
+    last = float(rows[-1].split(",")[0])
+    lock = math.asin(0.6) / 10.0
+    assert last <= lock < last + 0.005 + 1e-12
+    assert f"the {len(rows)} rows before the error, to t = {last:g} s, were written to r.csv" \
+        in run.stderr, run.stderr
+    assert not (tmp_path / "r.csv.part").exists()
+
+
+def test_a_table_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
+    # An interruption while writing (a second Ctrl-C) leaves the earlier file as it was.
+    path = tmp_path / "r.csv"
+    path.write_text("t\n0\n")
+    table = {"t": np.arange(1000.0), "x": np.arange(1000.0)}
+    calls = {"n": 0}
+    real_writerow = odyn.scene.csv.writer
+
+    class Interrupting:
+        def __init__(self, f, **kwargs):
+            self.writer = real_writerow(f, **kwargs)
+
+        def writerow(self, row):
+            calls["n"] += 1
+            if calls["n"] == 500:
+                raise KeyboardInterrupt
+            self.writer.writerow(row)
+
+    monkeypatch.setattr(odyn.scene.csv, "writer", Interrupting)
+    with pytest.raises(KeyboardInterrupt):
+        odyn.scene.write_table(table, path)
+    assert path.read_text() == "t\n0\n"
+    assert not (tmp_path / "r.csv.part").exists()
+    monkeypatch.undo()
+    odyn.scene.write_table(table, path)
+    assert path.read_text().count("\n") == 1001
+
+
+def test_an_exception_in_a_user_function_names_its_element_and_time():
+    # The exception stays the user's (its type and message), with a note saying where it rose.
+    m = falling_stone()
+
+    def push(t, body):
+        if t > 0.05:
+            raise ZeroDivisionError("boom")
+        return (0.0, 0.0, 0.0)
+    m.add_point_force(name="push", body="stone", force=push)
+    with pytest.raises(ZeroDivisionError, match="boom") as error:
+        odyn.simulate(m, t_end=0.2, integrator="generalized-alpha", step=1e-3,
+                      output_interval=0.01)
+    notes = getattr(error.value, "__notes__", [])
+    assert len(notes) == 1 and "point_force 'push'" in notes[0], notes
+    time = float(notes[0].split("at t = ")[1].split(" s")[0])
+    assert 0.05 < time <= 0.052
+    assert 5 <= len(error.value.result) <= 7  # the rows before it are kept
