@@ -43,13 +43,14 @@ BENCHMARK(HingeChainModes)
     ->Args({4000, 1})
     ->Unit(benchmark::kMillisecond);
 
-/// Arguments: links, and 1 for the sparse rows, 0 for the dense matrices.
+/// Arguments: links, and the path: 0 dense matrices, 1 sparse rows, 2 joint coordinates.
 void DrivenChainKinematics(benchmark::State& state) {
   const int links = static_cast<int>(state.range(0));
   const driven_chain::Chain chain = driven_chain::build(links);
   odyn::KinematicSettings settings;
   settings.linear_solver =
       state.range(1) == 1 ? odyn::LinearSolver::klu : odyn::LinearSolver::dense;
+  if (state.range(1) == 2) settings.coordinates = "joint";
   double tip_angle = 0.0;
   for (auto _ : state) {
     odyn::Workspace<driven_chain::Model> ws(chain.model);
@@ -60,11 +61,13 @@ void DrivenChainKinematics(benchmark::State& state) {
   // Against forward kinematics at the end.
   state.counters["tip_angle_error"] =
       std::abs(tip_angle - driven_chain::chain_at(links, 0.1).back().angle);
-  state.SetLabel(state.range(1) == 1 ? "sparse" : "dense");
+  state.SetLabel(state.range(1) == 2 ? "joint" : state.range(1) == 1 ? "sparse" : "dense");
 }
 BENCHMARK(DrivenChainKinematics)
     ->Args({100, 0})
     ->Args({100, 1})
+    ->Args({100, 2})
+    ->Args({400, 2})
     ->Args({1000, 1})
     ->Args({4000, 1})
     ->Args({16000, 1})

@@ -1,10 +1,11 @@
 // Kinematic analysis (analysis/kinematics.hpp): a fully driven mechanism against closed forms,
-// and the mechanisms it must refuse, with dense matrices and on sparse rows (the path of large
-// models, forced here by naming a sparse solver).
+// and the mechanisms it must refuse, with dense matrices, on sparse rows (the path of large
+// models, forced here by naming a sparse solver) and in joint coordinates.
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <odyn/analysis/kinematics.hpp>
@@ -17,10 +18,16 @@ namespace test_kinematics {
 
 namespace pl = odyn::planar;
 
-// The two linear algebras of a kinematic analysis.
-odyn::KinematicSettings with_solver(odyn::LinearSolver solver) {
+// The paths of a kinematic analysis: dense matrices ("dense"), sparse rows ("klu"; "auto"
+// chooses by the model's size) and joint coordinates ("joint", dense start checks).
+odyn::KinematicSettings on_path(const std::string& path) {
   odyn::KinematicSettings s;
-  s.linear_solver = solver;
+  if (path == "joint") {
+    s.coordinates = "joint";
+    s.linear_solver = odyn::LinearSolver::dense;
+  } else {
+    s.linear_solver = odyn::linear_solver_from_name(path);
+  }
   return s;
 }
 
@@ -57,8 +64,8 @@ TEST_CASE(
     "A driven four-bar moves as Freudenstein's equation says, with the motor's torque "
     "from the power balance",
     "[kinematics]") {
-  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
-  INFO("linear solver " << odyn::linear_solver_name(solver));
+  const std::string path = GENERATE(as<std::string>{}, "dense", "klu", "joint");
+  INFO("path " << path);
   const Freudenstein reference;
   const four_bar::Parameters& p = reference.p;
   four_bar::Linkage l = four_bar::build(p);
@@ -83,7 +90,7 @@ TEST_CASE(
         energy.push_back(odyn::kinetic_energy(l.model, s) + odyn::potential_energy(l.model, s));
         power.push_back(odyn::reaction(l.model, s, l.motor, odyn::Side::b).torque[0] * p.speed);
       },
-      with_solver(solver));
+      on_path(path));
   REQUIRE(times.size() == 1001);
   CHECK(times.back() == Approx(1.0).margin(1e-12));
   CHECK(angle_error < 1e-11);
@@ -162,8 +169,8 @@ TEST_CASE(
                  g * (rod_mass * (r * c + out.z) / 2.0 + piston_mass * out.z);
     return out;
   };
-  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
-  INFO("linear solver " << odyn::linear_solver_name(solver));
+  const std::string path = GENERATE(as<std::string>{}, "dense", "klu", "joint");
+  INFO("path " << path);
   odyn::Workspace<Model> ws(m);
   double z_error = 0.0, rate_error = 0.0, acceleration_error = 0.0, torque_error = 0.0;
   double largest_acceleration = 0.0, largest_torque = 0.0;
@@ -182,7 +189,7 @@ TEST_CASE(
         torque_error = std::max(torque_error, std::abs(torque - power / omega));
         largest_torque = std::max(largest_torque, std::abs(power / omega));
       },
-      with_solver(solver));
+      on_path(path));
   INFO("piston: z error " << z_error << " m, rate error " << rate_error
                           << " m/s, acceleration error " << acceleration_error << " of "
                           << largest_acceleration << " m/s^2; motor torque error " << torque_error
@@ -195,8 +202,8 @@ TEST_CASE(
 
 TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or over-driven",
           "[kinematics]") {
-  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
-  INFO("linear solver " << odyn::linear_solver_name(solver));
+  const std::string path = GENERATE(as<std::string>{}, "dense", "klu", "joint");
+  INFO("path " << path);
   SECTION("a degree of freedom left") {
     using Model = pl::Model<pl::Revolute, pl::Gravity>;
     Model m;
@@ -206,7 +213,7 @@ TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or
     odyn::Workspace<Model> ws(m);
     CHECK_THROWS_WITH(
         odyn::kinematic_analysis(
-            m, ws, 1.0, 0.1, [](const auto&) {}, with_solver(solver)),
+            m, ws, 1.0, 0.1, [](const auto&) {}, on_path(path)),
         Catch::Contains("1 degree of freedom remain") && Catch::Contains("its drivers: none"));
   }
   SECTION("a driver that repeats another") {
@@ -215,15 +222,24 @@ TEST_CASE("A kinematic analysis refuses a mechanism that is not fully driven, or
     l.model.add(pl::RevoluteDriver("second motor", o2, odyn::Motion::constant_velocity(1.0)));
     odyn::Workspace<four_bar::Model> ws(l.model);
     CHECK_THROWS_WITH(odyn::kinematic_analysis(
-                          l.model, ws, 1.0, 0.1, [](const auto&) {}, with_solver(solver)),
+                          l.model, ws, 1.0, 0.1, [](const auto&) {}, on_path(path)),
                       Catch::Contains("over-driven") && Catch::Contains("motor'"));
   }
   SECTION("an output interval too short to count its outputs") {
     four_bar::Linkage l = four_bar::build();
     odyn::Workspace<four_bar::Model> ws(l.model);
     CHECK_THROWS_WITH(odyn::kinematic_analysis(
-                          l.model, ws, 1.0, 1e-300, [](const auto&) {}, with_solver(solver)),
+                          l.model, ws, 1.0, 1e-300, [](const auto&) {}, on_path(path)),
                       Catch::Contains("asks for 1e+300 outputs"));
+  }
+  SECTION("coordinates it does not know") {
+    four_bar::Linkage l = four_bar::build();
+    odyn::Workspace<four_bar::Model> ws(l.model);
+    odyn::KinematicSettings s = on_path(path);
+    s.coordinates = "polar";
+    CHECK_THROWS_WITH(odyn::kinematic_analysis(
+                          l.model, ws, 1.0, 0.1, [](const auto&) {}, s),
+                      Catch::Contains("coordinates 'polar' unknown"));
   }
 }
 
@@ -246,19 +262,19 @@ TEST_CASE("A crank driven past its dead centre locks up, named with its time", "
   m.add(pl::Translational("slide", odyn::ground, {{0.0, 0.0}, {1.0, 0.0}}, slider,
                           {{0.0, 0.0}, {1.0, 0.0}}));
   m.add(pl::RevoluteDriver("motor", pivot, odyn::Motion::constant_velocity(speed)));
-  const auto solver = GENERATE(odyn::LinearSolver::dense, odyn::LinearSolver::klu);
-  INFO("linear solver " << odyn::linear_solver_name(solver));
+  const std::string path = GENERATE(as<std::string>{}, "dense", "klu", "joint");
+  INFO("path " << path);
   odyn::Workspace<Model> ws(m);
   double last = 0.0;
   const double lock = std::asin(rod / crank) / speed;  // the rod square to the slide
   REQUIRE_THROWS_AS(odyn::kinematic_analysis(
-                        m, ws, 2.0, 0.01, [&](const auto& s) { last = s.t; }, with_solver(solver)),
+                        m, ws, 2.0, 0.01, [&](const auto& s) { last = s.t; }, on_path(path)),
                     odyn::AssemblyError);
   CHECK(last < lock);
   CHECK(last > lock - 0.011);
   odyn::Workspace<Model> again(m);
   CHECK_THROWS_WITH(odyn::kinematic_analysis(
-                        m, again, 2.0, 0.01, [](const auto&) {}, with_solver(solver)),
+                        m, again, 2.0, 0.01, [](const auto&) {}, on_path(path)),
                     Catch::Contains("locks up after t = 0.5235"));
 }
 
@@ -281,8 +297,8 @@ TEST_CASE(
   REQUIRE(odyn::detail::sparse_kinematics(m, odyn::LinearSolver::automatic));
   auto cross = [](const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
 
-  const auto solver = GENERATE(odyn::LinearSolver::automatic, odyn::LinearSolver::dense);
-  INFO("linear solver " << odyn::linear_solver_name(solver));
+  const std::string path = GENERATE(as<std::string>{}, "auto", "dense", "joint");
+  INFO("path " << path);
   odyn::Workspace<driven_chain::Model> ws(m);
   double position_error = 0.0, velocity_error = 0.0, acceleration_error = 0.0;
   double torque_error = 0.0, largest_torque = 0.0, force_error = 0.0, largest_force = 0.0;
@@ -326,7 +342,7 @@ TEST_CASE(
           torque_above = torque;
         }
       },
-      with_solver(solver));
+      on_path(path));
   INFO("errors: position " << position_error << ", velocity " << velocity_error << ", acceleration "
                            << acceleration_error << ", force " << force_error << " of "
                            << largest_force << " N, torque " << torque_error << " of "

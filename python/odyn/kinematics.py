@@ -21,7 +21,7 @@ def _whole(value: Any, name: str, least: int) -> int:
 
 def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float = 1e-3,
                tolerance: float = 1e-12, max_iterations: int = 25, max_halvings: int = 12,
-               linear_solver: str = "auto",
+               linear_solver: str = "auto", coordinates: str = "absolute",
                progress: Optional[Callable[[float], None]] = None) -> Result:
     """Moves a fully driven mechanism (as many drivers as degrees of freedom) as its drivers
     prescribe, from t = 0 to t_end, whatever its masses; a row every `output_interval`.
@@ -35,7 +35,10 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
     fails is reached in up to `max_halvings` halves of the step. linear_solver: "dense" (a
     rank-revealing QR of whole matrices), "klu" or "cholmod" (the same here: sparse rows and a
     sparse LU, linear in the model's size) or "auto" (dense for small models, sparse above
-    100 velocities plus equations).
+    100 velocities plus equations). coordinates: "absolute" (every body's pose; every joint
+    an equation) or "joint" (a spanning tree's joint coordinates, only the joints that close
+    loops and the drivers as equations: the same motion and reactions, solved with the
+    closures' Jacobian; the checks at the start use linear_solver).
 
     Raises odyn.ModelError before it starts if the mechanism is not fully driven (how many
     degrees of freedom remain, and its drivers) or over-driven (which driver repeats the
@@ -52,7 +55,8 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
                 "tolerance": check_number(tolerance, "tolerance", positive=True),
                 "max_iterations": _whole(max_iterations, "max_iterations", 1),
                 "max_halvings": _whole(max_halvings, "max_halvings", 0),
-                "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)}
+                "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS),
+                "coordinates": check_choice(coordinates, "coordinates", ["absolute", "joint"])}
     data = modules.analysis(model.module, "kinematics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)

@@ -53,11 +53,15 @@ def closed_form(theta, omega):
     return [tuple(k * f for k, f in zip(scale, q)) for q in (x, phi, centre_x, centre_y)]
 
 
-@pytest.mark.parametrize("solver", ["dense", "klu"])
-def test_a_driven_slider_crank_follows_its_closed_form_and_power_balance(solver):
+# The paths of a kinematic analysis: dense matrices, sparse rows, joint coordinates.
+PATHS = {"dense": {"linear_solver": "dense"}, "klu": {"linear_solver": "klu"},
+         "joint": {"coordinates": "joint"}}
+
+
+@pytest.mark.parametrize("path", list(PATHS))
+def test_a_driven_slider_crank_follows_its_closed_form_and_power_balance(path):
     omega = 20.0
-    r = odyn.kinematics(slider_crank(omega), t_end=0.5, output_interval=0.01,
-                        linear_solver=solver)
+    r = odyn.kinematics(slider_crank(omega), t_end=0.5, output_interval=0.01, **PATHS[path])
     assert len(r) == 51 and r.kinematics["outputs"] == 51
     piston, rod = r.body("piston"), r.body("rod")
     torque = r.reaction("motor").torque
@@ -99,14 +103,14 @@ def test_an_over_driven_mechanism_names_the_driver():
         odyn.kinematics(slider_crank(10.0, second_motor=True), t_end=0.1)
 
 
-@pytest.mark.parametrize("solver", ["dense", "klu"])
-def test_a_lock_up_is_named_with_its_time_and_keeps_the_rows_before_it(solver):
+@pytest.mark.parametrize("path", list(PATHS))
+def test_a_lock_up_is_named_with_its_time_and_keeps_the_rows_before_it(path):
     """With the rod shorter than the crank, the crank cannot pass R sin(theta) = rod."""
     omega, rod = 10.0, 0.06
     lock = math.asin(rod / R) / omega
     with pytest.raises(odyn.AssemblyError, match="locks up") as error:
         odyn.kinematics(slider_crank(omega, rod=rod), t_end=0.5, output_interval=0.005,
-                        linear_solver=solver)
+                        **PATHS[path])
     rows = error.value.result
     assert 0 < len(rows) and rows.t[-1] <= lock < rows.t[-1] + 0.005 + 1e-12
 
@@ -118,6 +122,8 @@ def test_bad_settings_are_refused_by_name():
         odyn.kinematics(slider_crank(1.0), max_halvings=-1)
     with pytest.raises(odyn.SceneError, match="linear_solver"):
         odyn.kinematics(slider_crank(1.0), linear_solver="umfpack")
+    with pytest.raises(odyn.SceneError, match="coordinates"):
+        odyn.kinematics(slider_crank(1.0), coordinates="auto")
     with pytest.raises(odyn.ModelError, match="asks for 1e\\+300 outputs"):
         odyn.kinematics(slider_crank(1.0), output_interval=1e-300)
 
@@ -263,14 +269,14 @@ def test_scenes_name_the_analysis_and_the_command_line_runs_it(tmp_path, capsys)
     table = np.genfromtxt(out, delimiter=",", names=True)
     for t, x in zip(table["t"], table["x"]):
         assert x == pytest.approx(closed_form(omega * t, omega)[0][0], abs=1e-11)
-    # On sparse rows, as a large model's analysis runs.
-    assert cli.main(["run", str(path), "--linear-solver", "klu", "--quiet",
-                     "--out", str(out)]) == 0
-    sparse = np.genfromtxt(out, delimiter=",", names=True)
-    for t, x in zip(sparse["t"], sparse["x"]):
-        assert x == pytest.approx(closed_form(omega * t, omega)[0][0], abs=1e-11)
-    np.testing.assert_allclose(sparse["torque"], table["torque"],
-                               atol=1e-10 * np.abs(table["torque"]).max())
+    # On sparse rows, as a large model's analysis runs, and in joint coordinates.
+    for option in (["--linear-solver", "klu"], ["--coordinates", "joint"]):
+        assert cli.main(["run", str(path), *option, "--quiet", "--out", str(out)]) == 0
+        other = np.genfromtxt(out, delimiter=",", names=True)
+        for t, x in zip(other["t"], other["x"]):
+            assert x == pytest.approx(closed_form(omega * t, omega)[0][0], abs=1e-11)
+        np.testing.assert_allclose(other["torque"], table["torque"],
+                                   atol=1e-10 * np.abs(table["torque"]).max())
     # Asked for by name instead, the dynamic analysis runs the same scene (the driver moves
     # the crank as before).
     assert cli.main(["run", str(path), "--analysis", "dynamic", "--quiet", "--rtol", "1e-10",

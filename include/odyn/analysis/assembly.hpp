@@ -290,6 +290,21 @@ void solve_accelerations_dense(const Eigen::MatrixXd& mass, const Eigen::MatrixX
   ws.vdot = vdot;
   ws.lambda = lambda;
 }
+
+/// A damped Newton step: the largest of the fractions 1, 1/2, ..., 2^-29 of the step whose
+/// residual falls below `norm` (the smallest if none does). move(fraction) puts the positions
+/// that fraction of the step from the iteration's start; residual() is max |Phi| there, which
+/// it returns.
+template <class Move, class Residual>
+double damped_newton_step(double norm, Move&& move, Residual&& residual) {
+  double fraction = 1.0, trial = norm;
+  for (int halving = 0; halving < 30; ++halving, fraction *= 0.5) {
+    move(fraction);
+    trial = residual();
+    if (trial < norm) break;
+  }
+  return trial;
+}
 }  // namespace detail
 
 /// Positions only: Newton with minimum-norm steps. Throws AssemblyError naming the joint with
@@ -328,18 +343,15 @@ int assemble_positions(const Model& model, Workspace<Model>& ws, const AssemblyS
       step = -RankRevealingQr(jacobian, threshold).solve(ws.phi);
     }
     const Eigen::VectorXd start = ws.q;
-    // Halve the step until the residual decreases: a damped Newton method.
-    double fraction = 1.0;
-    double trial = norm;
-    for (int halving = 0; halving < 30; ++halving, fraction *= 0.5) {
-      for (int b = 0; b < model.num_bodies(); ++b)
-        Space::integrate(start.template segment<nq>(b * nq),
-                         fraction * step.template segment<nv>(b * nv),
-                         ws.q.template segment<nq>(b * nq));
-      trial = residual_norm();
-      if (trial < norm || !std::isfinite(norm)) break;
-    }
-    norm = trial;
+    norm = detail::damped_newton_step(
+        norm,
+        [&](double fraction) {
+          for (int b = 0; b < model.num_bodies(); ++b)
+            Space::integrate(start.template segment<nq>(b * nq),
+                             fraction * step.template segment<nv>(b * nv),
+                             ws.q.template segment<nq>(b * nq));
+        },
+        residual_norm);
   }
   if (!(norm <= s.tolerance)) {
     Eigen::Index row = 0;

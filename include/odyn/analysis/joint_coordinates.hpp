@@ -352,20 +352,7 @@ class JointCoordinates {
       angular(force_[i]).noalias() = -(Algebra::axes(frame) * torque_on(b));
       linear(force_[i]) = mass * Algebra::turn(angular(twist), linear(twist)) - force_on(b);
     }
-    // The closures' right-hand side in spatial form: gamma less Phi_linear (omega x v_centre),
-    // the part of the centre's acceleration that the spatial acceleration leaves out.
-    for_each_closure([&]<class E>(const E& element, const StateOf<E>& state, BlocksOf<E>& blocks,
-                                  int row, int) {
-      auto g = closure_rhs_.segment<E::num_equations>(row);
-      g = constraint_gamma(element, detail::input_of(element, ws_.frames, ws_.t), state);
-      for (int k = 0; k < E::num_bodies; ++k) {
-        const int b = element.bodies()[k].index;
-        if (b == 0) continue;
-        const Motion& twist = nodes_[node_of_[b]].twist;
-        g.noalias() -= blocks.jacobian[k].template leftCols<L>() *
-                       Algebra::turn(angular(twist), linear(twist));
-      }
-    });
+    closure_gamma(closure_rhs_);
     saddle_solve(true, true, closure_rhs_, qdd_, lambda_);
     return all_finite(qdd_) && all_finite(lambda_);
   }
@@ -527,6 +514,37 @@ class JointCoordinates {
 
   /// The closures' Phi at the loaded positions (constraints evaluated).
   const Eigen::VectorXd& constraint_values() const { return phi_; }
+
+  /// C (m x n): the closures' Jacobian in the joint rates at the loaded positions (constraints
+  /// evaluated), a pass down the tree per column. For the analyses that solve with C itself
+  /// (a fully driven mechanism's kinematics), where A's conditioning has no part to play.
+  void closure_jacobian(Eigen::MatrixXd& out) {
+    out.resize(num_equations(), num_velocities());
+    increment2_.setZero();
+    for (Eigen::Index j = 0; j < num_velocities(); ++j) {
+      increment2_[j] = 1.0;
+      motions_of_rates(increment2_, motion2_);
+      closure_rates(motion2_, out.col(j));
+      increment2_[j] = 0.0;
+    }
+  }
+
+  /// C theta'' - (gamma - Phi_q c) for the held theta'' at the loaded state (constraints
+  /// evaluated), c the bodies' accelerations at zero theta'': what the closures' acceleration
+  /// equations leave unmet.
+  const Eigen::VectorXd& acceleration_constraint_values() {
+    closure_gamma(closure_rhs_);
+    for (std::size_t i = 0; i < tree_.size(); ++i) {
+      motion_[i] = nodes_[i].bias;
+      if (tree_[i].parent_node >= 0)
+        motion_[i] += shifted_motion(motion_[tree_[i].parent_node], nodes_[i].offset);
+      motion_[i].noalias() += nodes_[i].motion.leftCols(tree_[i].dof()) *
+                              qdd_.segment(tree_[i].v_offset, tree_[i].dof());
+    }
+    closure_rates(motion_, acceleration_values_);
+    acceleration_values_ -= closure_rhs_;
+    return acceleration_values_;
+  }
 
   /// C theta' + Phi_t at the loaded state (constraints evaluated).
   const Eigen::VectorXd& velocity_constraint_values() {
@@ -1269,6 +1287,7 @@ class JointCoordinates {
     constraint_force_.setZero(Space::nv * model_.num_bodies());
     phi_t_.setZero(m);
     velocity_values_.setZero(m);
+    acceleration_values_.setZero(m);
     lambda_.setZero(m);
     multiplier_.setZero(m);
     closure_rhs_.setZero(m);
@@ -1405,16 +1424,37 @@ class JointCoordinates {
     }
   }
 
-  /// x - A^-1 C^T (C A^-1 C^T)^-1 C x, a rate-space vector with no component that C measures.
-  void remove_normal_part(Eigen::Ref<Eigen::VectorXd> x) {
+  /// The bodies' twists (global axes, at their centres) for the joint rates x: J x.
+  void motions_of_rates(const Eigen::Ref<const Eigen::VectorXd>& x, std::vector<Motion>& out) {
     for (std::size_t i = 0; i < tree_.size(); ++i) {
       const TreeBody& node = tree_[i];
-      motion2_[i] = node.parent_node >= 0
-                        ? shifted_motion(motion2_[node.parent_node], nodes_[i].offset)
-                        : Motion::Zero();
-      motion2_[i].noalias() +=
+      out[i] = node.parent_node >= 0 ? shifted_motion(out[node.parent_node], nodes_[i].offset)
+                                     : Motion::Zero();
+      out[i].noalias() +=
           nodes_[i].motion.leftCols(node.dof()) * x.segment(node.v_offset, node.dof());
     }
+  }
+
+  /// The closures' right-hand side in spatial form: gamma less Phi_linear (omega x v_centre),
+  /// the part of the centre's acceleration that the spatial acceleration leaves out.
+  void closure_gamma(Eigen::VectorXd& out) {
+    for_each_closure(
+        [&]<class E>(const E& element, const StateOf<E>& state, BlocksOf<E>& blocks, int row, int) {
+          auto g = out.segment<E::num_equations>(row);
+          g = constraint_gamma(element, detail::input_of(element, ws_.frames, ws_.t), state);
+          for (int k = 0; k < E::num_bodies; ++k) {
+            const int b = element.bodies()[k].index;
+            if (b == 0) continue;
+            const Motion& twist = nodes_[node_of_[b]].twist;
+            g.noalias() -= blocks.jacobian[k].template leftCols<L>() *
+                           Algebra::turn(angular(twist), linear(twist));
+          }
+        });
+  }
+
+  /// x - A^-1 C^T (C A^-1 C^T)^-1 C x, a rate-space vector with no component that C measures.
+  void remove_normal_part(Eigen::Ref<Eigen::VectorXd> x) {
+    motions_of_rates(x, motion2_);
     closure_rates(motion2_, closure_rhs_);
     closure_rhs_ = -closure_rhs_;
     saddle_solve(false, false, closure_rhs_, increment2_, multiplier_);
@@ -1589,6 +1629,7 @@ class JointCoordinates {
   Eigen::VectorXd constraint_force_;  // (6 nb) Phi_q^T lambda, in complete_workspace()
   Eigen::VectorXd phi_, phi_t_;       // (m) of the closures
   Eigen::VectorXd velocity_values_;   // (m) C theta' + Phi_t
+  Eigen::VectorXd acceleration_values_;  // (m) C theta'' - (gamma - Phi_q c)
   Eigen::VectorXd closure_rhs_;       // (m) a saddle-point solve's s
   Eigen::VectorXd multiplier_;        // (m) scratch
   std::vector<int> pinned_rows_;      // closure equations that repeat others (check_closures)

@@ -13,7 +13,9 @@
 // the assembly's rank pass in the model's topological order keeps n independent rows of
 // Phi_q, whose square matrix a sparse LU factorizes for the Newton steps and for the three
 // solves of a time (the multipliers with its transpose), at a cost linear in the model's size
-// (see SparseKinematics).
+// (see SparseKinematics). In joint coordinates (KinematicSettings::coordinates "joint") the
+// spanning tree's joints hold by construction and Newton runs on the loops' closures and the
+// drivers alone (see JointKinematics).
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -24,6 +26,7 @@
 #include <vector>
 
 #include "odyn/analysis/assembly.hpp"
+#include "odyn/analysis/joint_coordinates.hpp"
 #include "odyn/analysis/output_times.hpp"
 #include "odyn/analysis/system.hpp"
 #include "odyn/core/errors.hpp"
@@ -42,6 +45,11 @@ struct KinematicSettings {
   /// and a sparse LU, linear in the model's size; auto: dense up to dense_assembly_limit
   /// velocities plus equations, sparse above.
   LinearSolver linear_solver = LinearSolver::automatic;
+  /// "absolute": every body's position and orientation, every joint an equation; "joint": a
+  /// spanning tree's joint coordinates, the joints that close loops and the drivers as the
+  /// equations (see analysis/joint_coordinates.hpp). The same motion and reactions either way;
+  /// the start's checks (fully driven, not over-driven) use linear_solver.
+  std::string coordinates = "absolute";
 };
 
 /// What the constraint Jacobian says of a mechanism's motion at its current configuration.
@@ -74,6 +82,20 @@ bool sparse_kinematics(const Model& model, LinearSolver solver) {
   AssemblySettings s;
   s.linear_solver = solver;
   return sparse_assembly(model, s);
+}
+
+/// The error of a time whose Newton iteration did not meet the constraints: the joint with the
+/// largest residual in ws.phi.
+template <class Model>
+[[noreturn]] void throw_unmet(const Model& model, const Workspace<Model>& ws, int iterations,
+                              const std::string& note) {
+  Eigen::Index row = 0;
+  const double worst = ws.phi.size() > 0 ? ws.phi.cwiseAbs().maxCoeff(&row) : 0.0;
+  const std::string joint = ws.phi.size() > 0 ? model.constraint_name(static_cast<int>(row)) : "";
+  throw AssemblyError(
+      joint, "at t = " + to_text(ws.t) + " s the constraints and drivers could not be met after " +
+                 std::to_string(iterations) + " Newton iterations" + note + "; largest residual " +
+                 to_text(worst) + " at joint '" + joint + "'");
 }
 
 template <class Model>
@@ -252,29 +274,18 @@ class SparseKinematics {
       Eigen::VectorXd step(n_);
       for (int k = 0; k < n_; ++k) step[k] = -ws.phi[kept_[k]];
       lu_.solve_in_place(step);
-      // Halve the step until the residual decreases: a damped Newton method.
       const Eigen::VectorXd start = ws.q;
-      double fraction = 1.0, trial = norm;
-      for (int halving = 0; halving < 30; ++halving, fraction *= 0.5) {
-        for (int b = 0; b < model_.num_bodies(); ++b)
-          Space::integrate(start.template segment<nq>(b * nq),
-                           fraction * step.template segment<nv>(b * nv),
-                           ws.q.template segment<nq>(b * nq));
-        trial = residual_norm();
-        if (trial < norm) break;
-      }
-      norm = trial;
+      norm = damped_newton_step(
+          norm,
+          [&](double fraction) {
+            for (int b = 0; b < model_.num_bodies(); ++b)
+              Space::integrate(start.template segment<nq>(b * nq),
+                               fraction * step.template segment<nv>(b * nv),
+                               ws.q.template segment<nq>(b * nq));
+          },
+          residual_norm);
     }
-    if (!(norm <= s.tolerance)) {
-      Eigen::Index row = 0;
-      const double worst = m > 0 ? ws.phi.cwiseAbs().maxCoeff(&row) : 0.0;
-      const std::string joint = m > 0 ? model_.constraint_name(static_cast<int>(row)) : "";
-      throw AssemblyError(joint, "at t = " + to_text(ws.t) +
-                                     " s the constraints and drivers could not be met after " +
-                                     std::to_string(iteration) +
-                                     " Newton iterations; largest residual " + to_text(worst) +
-                                     " at joint '" + joint + "'");
-    }
+    if (!(norm <= s.tolerance)) throw_unmet(model_, ws, iteration, "");
   }
 
   /// Velocities, accelerations and multipliers at solved positions (constraints evaluated).
@@ -303,14 +314,120 @@ class SparseKinematics {
       throw_lock_up(model_, ws.t, {});
   }
 };
+
+/// The joint-coordinate path of a kinematic analysis (see analysis/joint_coordinates.hpp): the
+/// spanning tree's coordinates theta, with the joints that close loops and the drivers as the
+/// equations, C their Jacobian in the joint rates. A fully driven mechanism's C has full
+/// column rank (square unless closures repeat each other), so the constraints alone give the
+/// motion, as in absolute coordinates: Newton on the closures' Phi(theta, t) = 0, then
+/// C theta' = -Phi_t and C theta'' = gamma - Phi_q c (c the bodies' accelerations at zero
+/// theta''), with a rank-revealing QR of C; then C^T lambda = J^T (Q - the velocity terms) -
+/// A theta'', whose right side is the residual of the equations of motion at lambda = 0, by the
+/// recursive Newton-Euler algorithm. A itself is never factorized: its conditioning, which
+/// grows as a chain's length to the fourth, has no part in the answer. complete_workspace()
+/// then leaves q, v, v' and every joint's lambda as the absolute path does.
+template <class Model>
+class JointKinematics {
+ public:
+  /// Builds the tree at the workspace's assembled pose (every joint coordinate 0 there).
+  JointKinematics(const Model& model, Workspace<Model>& ws)
+      : model_(model), ws_(ws), coordinates_(model, ws) {}
+
+  /// Positions (Newton from the held coordinates), velocities, accelerations and multipliers
+  /// at time ws.t, left in the workspace.
+  void solve(const KinematicSettings& s) {
+    JointCoordinates<Model>& c = coordinates_;
+    const auto residual_norm = [&] {
+      c.update_frames();
+      c.evaluate_constraints();
+      return c.position_residual();
+    };
+    double norm = residual_norm();
+    int iteration = 0;
+    for (; iteration < s.max_iterations && norm > s.tolerance && std::isfinite(norm); ++iteration) {
+      factorize();
+      const Eigen::VectorXd start = c.positions();
+      const Eigen::VectorXd step = -qr_.solve(c.constraint_values());
+      norm = damped_newton_step(
+          norm, [&](double fraction) { c.integrate(start, fraction * step, c.positions()); },
+          residual_norm);
+    }
+    // The closures' rows of ws.phi are current, the tree joints' hold to rounding.
+    if (!(norm <= s.tolerance)) throw_unmet(model_, ws_, iteration, " (joint coordinates)");
+    factorize();  // at the solution, checking its rank
+    // C theta' = -Phi_t, one correction from the last rates (exact: the system is linear).
+    c.velocities() -= qr_.solve(c.velocity_constraint_values());
+    c.update_frames();  // the twists, and the accelerations they leave at zero theta''
+    initialize_states(model_, ws_);
+    c.accelerations().setZero();
+    c.accelerations() = -qr_.solve(c.acceleration_constraint_values());
+    c.evaluate_forces();
+    c.multipliers().setZero();
+    residual_.resize(c.num_velocities());
+    c.dynamics_residual(residual_);
+    c.multipliers() = -RankRevealingQr(jacobian_.transpose(), rank_tolerance).solve(residual_);
+    if (!c.velocities().allFinite() || !c.accelerations().allFinite() ||
+        !c.multipliers().allFinite())
+      throw_lock_up(model_, ws_.t, {});
+    c.complete_workspace();
+  }
+
+  /// Moves the held coordinates from the last solution by h theta' + h^2 / 2 theta''.
+  void predict(double h) {
+    JointCoordinates<Model>& c = coordinates_;
+    solved_positions_ = c.positions();
+    solved_velocities_ = c.velocities();
+    const Eigen::VectorXd move = h * c.velocities() + 0.5 * h * h * c.accelerations();
+    c.integrate(solved_positions_, move, c.positions());
+  }
+
+  /// Back to the last solution's coordinates and rates (before predict), to be solved again.
+  void restore() {
+    coordinates_.positions() = solved_positions_;
+    coordinates_.velocities() = solved_velocities_;
+  }
+
+ private:
+  /// C at the loaded positions and its rank-revealing QR; a lock-up where C's rank falls below
+  /// the number of joint coordinates (as the absolute path's test of Phi_q).
+  void factorize() {
+    coordinates_.closure_jacobian(jacobian_);
+    qr_.compute(jacobian_, rank_tolerance);
+    if (qr_.rank() < coordinates_.num_velocities()) throw_lock_up(model_, ws_.t, {});
+  }
+
+  const Model& model_;
+  Workspace<Model>& ws_;
+  JointCoordinates<Model> coordinates_;
+  Eigen::MatrixXd jacobian_;  // C
+  RankRevealingQr qr_;        // of C
+  Eigen::VectorXd residual_;
+  Eigen::VectorXd solved_positions_, solved_velocities_;
+};
+
+/// Refuses coordinates other than "absolute" and "joint"; true for "joint".
+inline bool joint_kinematics(const KinematicSettings& s) {
+  if (s.coordinates != "absolute" && s.coordinates != "joint")
+    throw ModelError("kinematic analysis",
+                     "coordinates '" + s.coordinates + "' unknown; use 'absolute' or 'joint'");
+  return s.coordinates == "joint";
+}
 }  // namespace detail
 
 /// Solves positions, velocities, accelerations and multipliers at time ws.t, from a nearby
 /// configuration in ws.q. Throws AssemblyError at a lock-up (Newton fails, or Phi_q loses
-/// rank), naming the time and the equations that became dependent.
+/// rank), naming the time and the equations that became dependent. (In joint coordinates the
+/// positions are assembled in absolute ones, then the rest solved in joint coordinates.)
 template <class Model>
 void solve_kinematics(const Model& model, Workspace<Model>& ws, const KinematicSettings& s = {}) {
-  if (detail::sparse_kinematics(model, s.linear_solver))
+  if (detail::joint_kinematics(s)) {
+    AssemblySettings positions;
+    positions.tolerance = s.tolerance;
+    positions.max_iterations = s.max_iterations;
+    positions.linear_solver = s.linear_solver;
+    assemble_positions(model, ws, positions);
+    detail::JointKinematics<Model>(model, ws).solve(s);
+  } else if (detail::sparse_kinematics(model, s.linear_solver))
     detail::SparseKinematics<Model>(model).solve(ws, s);
   else
     detail::solve_kinematics_dense(model, ws, s);
@@ -354,15 +471,22 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
     throw ModelError("kinematic analysis", "expected an end time >= the start time " +
                                                to_text(ws.t) + ", got " + to_text(t_end));
   detail::output_count("kinematic analysis", ws.t, t_end, interval);  // refuses a tiny interval
+  const bool in_joint_coordinates = detail::joint_kinematics(s);
   AssemblySettings start;
   start.tolerance = s.tolerance;
   start.linear_solver = s.linear_solver;
   assemble_positions(model, ws, start);
   require_fully_driven(model, ws, s.linear_solver);
+  std::optional<detail::JointKinematics<Model>> joint;
   std::optional<detail::SparseKinematics<Model>> sparse;
-  if (detail::sparse_kinematics(model, s.linear_solver)) sparse.emplace(model);
+  if (in_joint_coordinates)
+    joint.emplace(model, ws);
+  else if (detail::sparse_kinematics(model, s.linear_solver))
+    sparse.emplace(model);
   const auto solve = [&] {
-    if (sparse)
+    if (joint)
+      joint->solve(s);
+    else if (sparse)
       sparse->solve(ws, s);
     else
       detail::solve_kinematics_dense(model, ws, s);
@@ -374,17 +498,24 @@ void kinematic_analysis(const Model& model, Workspace<Model>& ws, double t_end, 
   auto step = [&](double to) {
     const Eigen::VectorXd q = ws.q;
     const double from = ws.t, h = to - from;
-    const Eigen::VectorXd move = h * ws.v + 0.5 * h * h * ws.vdot;
-    for (int b = 0; b < model.num_bodies(); ++b)
-      Model::Space::integrate(q.template segment<nq>(b * nq), move.template segment<nv>(b * nv),
-                              ws.q.template segment<nq>(b * nq));
+    if (joint) {
+      joint->predict(h);
+    } else {
+      const Eigen::VectorXd move = h * ws.v + 0.5 * h * h * ws.vdot;
+      for (int b = 0; b < model.num_bodies(); ++b)
+        Model::Space::integrate(q.template segment<nq>(b * nq), move.template segment<nv>(b * nv),
+                                ws.q.template segment<nq>(b * nq));
+    }
     ws.t = to;
     try {
       solve();
       return true;
     } catch (const AssemblyError&) {
       ws.t = from;
-      ws.q = q;
+      if (joint)
+        joint->restore();
+      else
+        ws.q = q;
       solve();  // restores the solved state's v, v' and lambda
       return false;
     }

@@ -645,6 +645,7 @@ inline KinematicSettings kinematic_settings(const py::dict& d) {
   s.max_iterations = get(d, "max_iterations", s.max_iterations);
   s.max_halvings = get(d, "max_halvings", s.max_halvings);
   s.linear_solver = linear_solver_from_name(get(d, "linear_solver", std::string("auto")));
+  s.coordinates = get(d, "coordinates", s.coordinates);
   return s;
 }
 
