@@ -5,7 +5,7 @@ equation as tests/reference/engine_reference.hpp), integrated by SciPy's LSODA (
 Adams while not stiff) and DOP853 with every stroke boundary theta = n pi located as an event and
 the integration restarted there. The counts are a floor for any integrator of these families:
 odyn's integrators solve the 18-coordinate system at each evaluation, so CPU time is about
-these counts times the cost of one evaluation of the full system (see the README's
+these counts times the cost of one evaluation of the full system (see docs/benchmarks.md's
 work-precision section).
 
     python bench/minimal_ode_evaluations.py     # needs numpy and scipy (pip install scipy)

@@ -69,7 +69,7 @@ TEST_CASE("engine: consistent start matches the minimal-coordinate equations", "
 TEST_CASE("engine: generalized-alpha against the reference, second order", "[engine]") {
   const auto reference = engine_reference::solve(1.0, 1e-3);
   const Errors fine = run([] { return engine::build(); }, 1e-4, 1.0, reference);
-  // Second-order global error at h = 1e-4 (measured 5.0e-4 rad; see the README's table).
+  // Second-order global error at h = 1e-4 (measured 5.0e-4 rad; see docs/benchmarks.md).
   CHECK(fine.theta < 7e-4);
   CHECK(fine.z_piston < 3e-5);
   CHECK(fine.reaction < 30.0);  // N, against a peak of 24.5 kN

@@ -849,7 +849,7 @@ TopRun run_heavy_top(double step, double t_end, const Eigen::Quaterniond& refere
 TEST_CASE("Heavy top: conserved quantities, and second order on the rotation group",
           "[hard][heavy-top]") {
   // m = 15 kg, J = diag(0.234375, 0.46875, 0.234375) kg m^2, centre of mass 1 m along the body
-  // y axis from the pivot, spinning at 150 rad/s about it (rho_inf 0.9, see README).
+  // y axis from the pivot, spinning at 150 rad/s about it (rho_inf 0.9, see docs/examples.md).
   const double t_end = 0.5;
   const Eigen::Quaterniond reference = heavy_top_reference(heavy_top::Parameters{}, t_end, 1e-5);
   // The reference at half its step agrees to far below the errors measured here.

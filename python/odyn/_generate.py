@@ -198,7 +198,7 @@ def elements_markdown() -> str:
         "",
         "## Adding an element",
         "",
-        "1. Write its header: the blocks (see the README's *Writing an element*), then",
+        "1. Write its header: the blocks (see writing-elements.md), then",
         "   `static constexpr ElementDescription description{type, category, summary, "
         "parameters, outputs}` and `template <class Reader> static E from_parameters(Reader& "
         "r)`, which builds it with `parameter<T>(r, \"key\")` for each described key (the lists "

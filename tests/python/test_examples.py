@@ -76,8 +76,8 @@ def planar_twin(tmp_path_factory):
 
 def test_slider_crank_planar_twin_equals_the_spatial_engine(planar_twin):
     """The planar slider-crank discretizes the engine's motion as the spatial model does:
-    README, "Model only what a scene needs" (measured 2.2e-7 m apart; both are 2e-5 m off the
-    exact motion)."""
+    docs/writing-elements.md, "Model only what a scene needs" (measured 2.2e-7 m apart; both
+    are 2e-5 m off the exact motion)."""
     stdout, header, data = planar_twin
     assert header == ENGINE_COLUMNS and data.shape == (1001, 7)
     assert "9 coordinates, 8 constraint equations" in stdout and "steps 10050" in stdout
