@@ -571,6 +571,13 @@ TEST_CASE("Run settings", "[errors]") {
                                                                        [](const Workspace&) {}),
                            odyn::ModelError, ModelErrorAbout("dynamics", {"t_end"}));
   }
+  SECTION("a step too short to advance time (it ran into NaN, blamed on an element)") {
+    settings.step = 1e-300;
+    REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
+                                                                       [](const Workspace&) {}),
+                           odyn::ModelError,
+                           ModelErrorAbout("dynamics", {"1e-300", "time would not advance"}));
+  }
   SECTION("an output interval too short to count (its count overflowed into one row)") {
     settings.output_interval = 1e-300;
     REQUIRE_THROWS_MATCHES(odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,

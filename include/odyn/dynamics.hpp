@@ -496,6 +496,13 @@ RunSummary start_run(const Model& model, Workspace<Model>& ws, const DynamicsSet
   if (!(s.rtol > 0.0) || !(s.atol > 0.0))
     throw ModelError("dynamics", "rtol and atol must be positive (got rtol " + to_text(s.rtol) +
                                      ", atol " + to_text(s.atol) + ")");
+  // Below about 5 machine epsilons of the start time, t + step rounds back to t.
+  if (const double least = 1e-15 * std::max(1.0, std::abs(ws.t)); s.step < least)
+    throw ModelError(
+        "dynamics", "a step of " + to_text(s.step) +
+                        " s is below what double precision resolves at t = " + to_text(ws.t) +
+                        " s, so time would not advance; give a step of at least " + to_text(least) +
+                        " s");
   if (!(s.rtol < 1.0))
     throw ModelError("dynamics", "rtol " + to_text(s.rtol) +
                                      " is a relative error of 100% or more, which controls "

@@ -8,7 +8,7 @@ from typing import Any, Callable, Dict, List, Optional
 import numpy as np
 
 from . import modules
-from ._schema import check_choice, check_number, fail
+from ._schema import check_callable, check_choice, check_number, fail
 from .model import BaseModel
 from .results import LINEAR_SOLVERS, Result, finished_run
 
@@ -57,6 +57,8 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
                 "max_halvings": _whole(max_halvings, "max_halvings", 0),
                 "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS),
                 "coordinates": check_choice(coordinates, "coordinates", ["absolute", "joint"])}
+    if progress is not None:
+        check_callable(progress, "progress")
     data = modules.analysis(model.module, "kinematics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)

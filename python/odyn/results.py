@@ -8,7 +8,8 @@ from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tup
 import numpy as np
 
 from . import _core
-from ._schema import SceneError, check_choice, check_count, check_number, check_tolerance
+from ._schema import (SceneError, check_callable, check_choice, check_count, check_number,
+                      check_tolerance, fail)
 from .model import BaseModel
 
 #: Integrators whose step is fixed unless `adaptive` (error control) is on.
@@ -423,6 +424,10 @@ class Result:
         return f"<odyn.Result: {len(self.t)} outputs, t = 0 .. {end} s{note}>"
 
 
+#: The smallest step (a run starts at t = 0): about 5 machine epsilons of 1 s, below which
+#: t + step rounds back to t (the C++ core refuses it too, relative to its start time).
+STEP_RESOLUTION = 1e-15
+
 #: The tolerances of simulate() besides rtol and atol: positive, newton_rtol below 1 too.
 RUN_TOLERANCES = ("newton_rtol", "newton_atol", "constraint_tolerance", "projection_tolerance")
 
@@ -433,9 +438,14 @@ def _settings(step: float, t_end: float, output_interval: float, integrator: str
     """The settings dict of _core.simulate, checked. `adaptive` None: error control for
     generalized-alpha and hht exactly when rtol or atol is given (as the C++ examples do)."""
     names = integrators()
+    step = check_number(step, "step", positive=True)
+    t_end = check_number(t_end, "t_end", minimum=0.0)
+    if step < STEP_RESOLUTION:
+        fail("step", f"a step of {step:g} s is below what double precision resolves at t = 0 s, "
+             f"so time would not advance; give a step of at least {STEP_RESOLUTION:g} s")
     settings: Dict[str, Any] = {
-        "step": check_number(step, "step", positive=True),
-        "t_end": check_number(t_end, "t_end", minimum=0.0),
+        "step": step,
+        "t_end": t_end,
         "output_interval": check_number(output_interval, "output_interval", positive=True),
         "integrator": check_choice(integrator, "integrator", list(names)),
         "rho_inf": check_number(rho_inf, "rho_inf", minimum=0.0),
@@ -594,6 +604,8 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
     settings["events"] = model._event_table()
+    if progress is not None:
+        check_callable(progress, "progress")
     return finished_run(model, model.module.simulate(model._core, settings, progress))
 
 

@@ -8,7 +8,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 from . import modules
-from ._schema import check_choice, check_flag, check_number, fail
+from ._schema import check_callable, check_choice, check_flag, check_number, fail
 from .model import BaseModel
 from .results import Result, finished_run
 
@@ -90,6 +90,8 @@ def quasi_statics(model: BaseModel, *, t_end: float = 1.0, output_interval: floa
     settings.update(t_end=t_end, max_halvings=max_halvings,
                     output_interval=check_number(output_interval, "output_interval",
                                                  positive=True))
+    if progress is not None:
+        check_callable(progress, "progress")
     data = modules.analysis(model.module, "quasi_statics")(model._core, settings, progress)
     data["summary"] = None
     return finished_run(model, data)

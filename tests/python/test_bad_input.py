@@ -48,6 +48,9 @@ BAD_RUN_SETTINGS = [
      ["projection_tolerance", "positive"]),
     ("an output interval too short to count", {"output_interval": 1e-300},
      ["1e-300", "give a longer interval"]),
+    ("a step too short to advance time", {"integrator": "generalized-alpha", "step": 1e-300},
+     ["step", "1e-300", "time would not advance"]),
+    ("a progress function that is not one", {"progress": 3}, ["progress", "callable"]),
 ]
 
 
