@@ -106,6 +106,9 @@ ANALYSES: Dict[str, Tuple[str, ...]] = {
     "modes": ("max_iterations", "coordinates"),
     "linear": ("max_iterations", "coordinates", "find_equilibrium", "inputs", "outputs"),
 }
+#: The image formats a scene's figure may be written in (by its file name's extension).
+FIGURE_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
+
 #: The analyses that run through time, from 0 to t_end (the others give one configuration).
 TIMED = ("dynamic", "kinematic", "quasi_static")
 
@@ -385,6 +388,14 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
 def _check_figure(f: Any, where: str, columns: List[str]) -> Dict[str, Any]:
     d = check_keys(f, where, ("file", "y", "title", "ylabel", "offset", "scale"), ("file", "y"))
     check_name(d["file"], f"{where}.file")
+    # A name inside the figures' folder: a scene from elsewhere writes nowhere else.
+    if os.path.basename(d["file"]) != d["file"] or d["file"] in (".", ".."):
+        fail(f"{where}.file", f"{d['file']!r} is not a file name; a figure is written into the "
+             "folder given to --figures, so give its name alone (\"piston.png\")")
+    extension = os.path.splitext(d["file"])[1].lower()
+    if extension not in FIGURE_FORMATS:
+        fail(f"{where}.file", f"{d['file']!r}: expected a file name ending in "
+             f"{', '.join(FIGURE_FORMATS)}")
     ys = d["y"] if isinstance(d["y"], list) else [d["y"]]
     for i, y in enumerate(ys):
         if y not in columns:
@@ -426,6 +437,9 @@ def column(result: Result, spec: Mapping[str, Any]) -> np.ndarray:
 
 def from_dict(d: Any, where: str = "") -> Scene:
     """A scene from parsed JSON; errors name the place in it."""
+    if not isinstance(d, Mapping):
+        fail(where or "scene", "expected a JSON object ({\"bodies\": [...], ...}) at the top, "
+             f"got {_schema._describe(d)}")
     d = check_keys(d, where, TOP_KEYS, ("bodies",))
     prefix = f"{where}." if where else ""
     if "odyn" in d and d["odyn"] != FORMAT_VERSION:

@@ -97,6 +97,10 @@ BAD_SCENES = [
      ["bodies[0].name", "lone surrogate"]),
     ("a relative tolerance of 1e300", _set(["analysis", "rtol"], 1e300),
      ["analysis.rtol", "below 1"]),
+    ("a figure outside the figures' folder", _set(["figures", 0, "file"], "../../x.png"),
+     ["figures[0].file", "not a file name"]),
+    ("a figure in a format that cannot be drawn", _set(["figures", 0, "file"], "x.txt"),
+     ["figures[0].file", ".png"]),
 ]
 
 
@@ -119,6 +123,7 @@ def test_scenes_are_refused_with_the_place(kind, spoil, words, tmp_path):
 
 
 SCENE_TEXTS = [
+    ("a list at the top", lambda text: "[" + text + "]", ["scene: expected a JSON object"]),
     ("a key given twice", lambda text: text.replace('"mass": 1.399', '"mass": 1.399, "mass": 2'),
      ["'mass' appears twice", "remove one"]),
     ("nesting thousands deep", lambda text: text[:-2] + ', "x": ' + "[" * 100000
