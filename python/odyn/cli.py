@@ -208,19 +208,58 @@ def _settings(args: argparse.Namespace, scene: Scene, kind: str) -> dict:
     return settings
 
 
+def _probe_writable(option: str, given: str, path: str) -> None:
+    """Creates and removes `path`, so that a file the run would write at its end (for the
+    option's value `given`) is known to be writable before the run starts (permissions,
+    read-only or special file systems)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ValueError(f"{option} {given}: the folder {folder} does not exist; create it "
+                         "first")
+    try:
+        with open(path, "xb"):
+            pass
+        os.remove(path)
+    except FileExistsError:
+        if not os.access(path, os.W_OK):
+            raise ValueError(f"{option} {given}: not writable here (permission denied); choose "
+                             "another place") from None
+    except OSError as e:
+        raise ValueError(f"{option} {given}: cannot be written here ({e.strerror}); choose "
+                         "another place") from None
+
+
 def _check_output_path(path: str) -> None:
-    """Refuses, before any work, an --out that could not be written at the end."""
+    """Refuses, before any work, an --out that could not be written at the end (it is written
+    beside its place, then renamed: see write_table)."""
     if not path.endswith((".csv", ".npz")):
         raise ValueError(f"--out {path}: expected a .csv or .npz file name")
-    folder = os.path.dirname(os.path.abspath(path))
     if os.path.isdir(path):
         raise ValueError(f"--out {path}: is a directory; give a file name")
-    if not os.path.isdir(folder):
-        raise ValueError(f"--out {path}: the folder {folder} does not exist; create it first")
-    if not os.access(folder, os.W_OK | os.X_OK) or (os.path.exists(path)
-                                                    and not os.access(path, os.W_OK)):
-        raise ValueError(f"--out {path}: not writable here (permission denied); choose another "
-                         "place")
+    _probe_writable("--out", path, path + ".part")
+
+
+def _check_drawings(args: argparse.Namespace) -> None:
+    """Refuses, before any work, a --plot, --gif or --figures that could not be drawn."""
+    if args.gif:
+        if not args.gif.lower().endswith(".gif"):
+            raise ValueError(f"--gif {args.gif}: expected a .gif file name")
+        _probe_writable("--gif", args.gif, args.gif)
+    if args.plot:
+        from matplotlib.figure import Figure
+        formats = Figure().canvas.get_supported_filetypes()
+        extension = os.path.splitext(args.plot)[1].lstrip(".").lower()
+        if extension not in formats:
+            raise ValueError(f"--plot {args.plot}: expected a file name ending in one of "
+                             f"{', '.join('.' + f for f in sorted(formats))}")
+        _probe_writable("--plot", args.plot, args.plot)
+    if args.figures is not None:
+        try:
+            os.makedirs(args.figures, exist_ok=True)
+        except OSError as e:
+            raise ValueError(f"--figures {args.figures}: cannot create the folder ({e.strerror}); "
+                             "choose another place") from None
+        _probe_writable("--figures", args.figures, os.path.join(args.figures, ".odyn-write-test"))
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -236,9 +275,11 @@ def _run(args: argparse.Namespace) -> int:
         if drawn:
             raise ValueError(f"{', '.join(drawn)}: draws a run against time; a {kind} analysis "
                              "gives one configuration")
+        _check_drawings(args)  # a mode's --gif
         if kind == "linear":
             return _run_linear(args, scene, settings)
         return _run_at_rest(args, scene, kind, settings)
+    _check_drawings(args)
     progress = _Progress(settings["t_end"], not args.quiet and sys.stderr.isatty())
     start = time.monotonic()
     interrupted = False

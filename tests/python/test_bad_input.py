@@ -154,20 +154,25 @@ def test_a_scene_file_that_is_not_utf8(tmp_path):
         odyn.load(path)
 
 
-@pytest.mark.parametrize("out, words", [
-    ("missing/r.csv", ["does not exist", "create it first"]),
-    ("folder.csv", ["is a directory"]),
-    ("r.txt", ["expected a .csv or .npz"]),
+@pytest.mark.parametrize("option, words", [
+    (["--out", "missing/r.csv"], ["--out missing/r.csv: the folder", "does not exist"]),
+    (["--out", "folder.csv"], ["is a directory"]),
+    (["--out", "r.txt"], ["expected a .csv or .npz"]),
+    (["--out", "/proc/r.csv"], ["--out /proc/r.csv: cannot be written here"]),
+    (["--gif", "r.txt"], ["--gif r.txt: expected a .gif file name"]),
+    (["--gif", "missing/r.gif"], ["--gif missing/r.gif: the folder", "does not exist"]),
+    (["--plot", "r.txt"], ["--plot r.txt: expected a file name ending in one of", ".png"]),
+    (["--figures", "/proc/figures"], ["--figures /proc/figures: cannot create the folder"]),
 ])
-def test_an_output_the_cli_could_not_write_is_refused_before_the_run(out, words, tmp_path):
+def test_an_output_the_cli_could_not_write_is_refused_before_the_run(option, words, tmp_path):
     (tmp_path / "folder.csv").mkdir()
     # t_end 1e4 s: a run that started would take minutes, and the test's timeout stops it.
     run = subprocess.run([sys.executable, "-m", "odyn", "run", str(SCENE), "--t-end", "1e4",
-                          "--out", out], capture_output=True, text=True, cwd=tmp_path,
-                         timeout=120)
+                          *option], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert run.returncode == 1, run.stderr
     for word in words:
         assert word in run.stderr, run.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.csv"]  # nothing left behind
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")
