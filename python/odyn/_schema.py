@@ -91,6 +91,18 @@ def check_vector(x: Any, where: str, size: int = 3, *, nonzero: bool = False) ->
     return values
 
 
+def check_quaternion(x: Any, where: str) -> List[float]:
+    """A unit quaternion (w, x, y, z): one whose length is 1 to within 1e-3, so that a rounded
+    one (0.7071, 0, 0, 0.7071) passes (normalized by the core) while (2, 0, 0, 0), which is no
+    rotation as given, is refused rather than silently scaled."""
+    values = check_vector(x, where, 4, nonzero=True)
+    length = math.sqrt(sum(v * v for v in values))
+    if abs(length - 1.0) > 1e-3:
+        fail(where, f"expected a unit quaternion (w, x, y, z), got {_describe(x)} of length "
+             f"{length:.6g}; divide it by its length if its direction is the rotation meant")
+    return values
+
+
 def check_name(x: Any, where: str) -> str:
     if not isinstance(x, str) or not x.strip():
         fail(where, f"expected a non-empty name (a string), got {_describe(x)}")
@@ -646,7 +658,7 @@ def check_body(params: Mapping[str, Any], where: str, names: Sequence[str],
         if kind == "inertia":
             out[key] = check_inertia(value, w)
         elif kind == "quaternion":
-            out[key] = check_vector(value, w, 4, nonzero=True)
+            out[key] = check_quaternion(value, w)
         elif kind == "flags":
             if value is not None and (not isinstance(value, (list, tuple)) or len(value) != flags
                                       or not all(isinstance(f, bool) for f in value)):

@@ -49,8 +49,8 @@ def check_parts(x: Any, where: str, space: str) -> List[Dict[str, Any]]:
             part["inertia"] = _schema.check_inertia(d["inertia"], f"{w}.inertia")
         part["at"] = _schema.check_vector(d.get("at", [0.0] * dim), f"{w}.at", dim)
         if space != "planar":
-            part["orientation"] = _schema.check_vector(d.get("orientation", [1.0, 0.0, 0.0, 0.0]),
-                                                       f"{w}.orientation", 4, nonzero=True)
+            part["orientation"] = _schema.check_quaternion(
+                d.get("orientation", [1.0, 0.0, 0.0, 0.0]), f"{w}.orientation")
         out.append(part)
     return out
 

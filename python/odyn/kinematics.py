@@ -9,7 +9,7 @@ import numpy as np
 
 from . import modules
 from ._schema import check_callable, check_choice, check_number, fail
-from .model import BaseModel
+from .model import BaseModel, check_model
 from .results import LINEAR_SOLVERS, Result, finished_run
 
 
@@ -46,6 +46,7 @@ def kinematics(model: BaseModel, *, t_end: float = 1.0, output_interval: float =
     dependent), with the rows up to there as the error's `result`. Ctrl-C raises
     odyn.Interrupted with the rows so far. progress(t) is called about every 0.2 s.
     `result.kinematics`: {"outputs", "wall_seconds"}."""
+    check_model(model)
     t_end = check_number(t_end, "t_end")
     if t_end < 0:
         fail("t_end", f"expected an end time >= 0, got {t_end!r}")
@@ -150,6 +151,7 @@ def check(model: BaseModel, *, tolerance: float = 1e-12, max_iterations: int = 5
     bodies it moved, the given velocity components it kept or changed). `print(report)` gives
     it as text. Raises odyn.AssemblyError if the model does not assemble. linear_solver: as
     in `kinematics` (the rank of large models' Jacobians by sparse elimination)."""
+    check_model(model)
     data = modules.analysis(model.module, "check")(model._core, {
         "assembly_tolerance": check_number(tolerance, "tolerance", positive=True),
         "assembly_max_iterations": _whole(max_iterations, "max_iterations", 1),

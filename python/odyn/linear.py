@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _schema, modules
 from ._schema import check_choice, check_flag, check_vector, fail
-from .model import BaseModel
+from .model import BaseModel, check_model
 from .results import Result
 from .statics import _result, _static_settings
 
@@ -163,6 +163,7 @@ def linearize(model: BaseModel, *, inputs: Optional[Mapping[str, Mapping[str, An
     points' positions or velocities ("tip.velocity.x"). The matrices come from differences of
     the constrained dynamics themselves, independently of odyn.modes' stiffness and damping.
     coordinates: "absolute" or "joint" (the state's chart follows them)."""
+    check_model(model)
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
                                 max_load_steps, relaxation, "dense")
     settings["find_equilibrium"] = check_flag(find_equilibrium, "find_equilibrium")

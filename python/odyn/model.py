@@ -217,7 +217,7 @@ class BaseModel:
             point["orientation"] = (
                 _schema.check_number(d["orientation"], f"{where}.orientation")
                 if self.space == "planar" else
-                _schema.check_vector(d["orientation"], f"{where}.orientation", 4, nonzero=True))
+                _schema.check_quaternion(d["orientation"], f"{where}.orientation"))
         self._points[name] = point
         return name
 
@@ -484,6 +484,13 @@ class PlanarModel(BaseModel, PlanarElements):
                       velocity_given=velocity_given, parts=parts)
         return self._add_body({k: v for k, v in params.items() if v is not None},
                               f"body '{name}'")
+
+
+def check_model(model: Any) -> None:
+    """Refuses, before any work, an analysis's first argument that is not a model."""
+    if not isinstance(model, BaseModel):
+        raise TypeError("model: expected an odyn.Model or odyn.PlanarModel (or a module's "
+                        f"model), got {_schema._describe(model)}")
 
 
 def new_model(space: str = "spatial", module: Any = None) -> BaseModel:

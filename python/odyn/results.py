@@ -10,7 +10,7 @@ import numpy as np
 from . import _core
 from ._schema import (SceneError, check_callable, check_choice, check_count, check_number,
                       check_tolerance, fail)
-from .model import BaseModel
+from .model import BaseModel, check_model
 
 #: Integrators whose step is fixed unless `adaptive` (error control) is on.
 ADAPTIVE_OPTIONAL = ("generalized-alpha", "hht")
@@ -511,6 +511,7 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
     `RedundantConstraintsWarning`. linear_solver: as in `simulate`. The model keeps the
     assembled state until it changes: `simulate` with the same assembly settings starts from
     it instead of assembling again."""
+    check_model(model)
     data = model.module.assemble(model._core, {
         "assembly_tolerance": tolerance, "assembly_max_iterations": max_iterations,
         "linear_solver": check_choice(linear_solver, "linear_solver", LINEAR_SOLVERS)})
@@ -589,6 +590,7 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     as its `result` attribute. A consistently over-constrained mechanism runs with minimum-norm
     multipliers and a `RedundantConstraintsWarning` (see `Result.redundant_equations`).
     """
+    check_model(model)
     if integrator is None:
         integrator = chosen_integrator({"step": step, "rtol": rtol, "atol": atol,
                                         "adaptive": adaptive})

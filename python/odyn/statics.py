@@ -9,7 +9,7 @@ import numpy as np
 
 from . import modules
 from ._schema import check_callable, check_choice, check_flag, check_number, fail
-from .model import BaseModel
+from .model import BaseModel, check_model
 from .results import Result, finished_run
 
 #: The coordinates a static or modal analysis may run in.
@@ -60,6 +60,7 @@ def statics(model: BaseModel, *, coordinates: str = "absolute", tolerance: float
     coordinates: "absolute" or "joint" (as in `simulate`). method: "automatic", "dense" or
     "sparse" (see STATIC_METHODS; the sparse method judges stability from the lowest six
     squared frequencies)."""
+    check_model(model)
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,
                                 max_load_steps, relaxation, method)
     return _result(model, modules.analysis(model.module, "statics")(model._core, settings))
@@ -80,6 +81,7 @@ def quasi_statics(model: BaseModel, *, t_end: float = 1.0, output_interval: floa
     torque a slowly turned crank needs), and `result.statics` lists each row's summary.
     Raises odyn.SolverError where no equilibrium is found, with the rows up to there as the
     error's `result`; Ctrl-C raises odyn.Interrupted. progress(t) is called about every 0.2 s."""
+    check_model(model)
     t_end = check_number(t_end, "t_end")
     if t_end < 0:
         fail("t_end", f"expected an end time >= 0, got {t_end!r}")
@@ -228,6 +230,7 @@ def modes(model: BaseModel, *, coordinates: str = "absolute", find_equilibrium: 
     (large models in absolute coordinates, the default above 600 velocity coordinates) the
     lowest `count` undamped ones by shift-invert Lanczos, the damped ones only where nothing
     damps, and no `linearization` matrices. See `Modes`."""
+    check_model(model)
     if not isinstance(count, int) or isinstance(count, bool) or count < 0:
         fail("count", f"expected a whole number of at least 0 (0: all), got {count!r}")
     settings = _static_settings(coordinates, tolerance, max_iterations, load_stepping,

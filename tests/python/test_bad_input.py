@@ -74,6 +74,25 @@ def test_a_run_ends_at_t_end_between_two_outputs(integrator):
         np.testing.assert_allclose(r.q[:, 2], -0.5 * 9.81 * r.t ** 2, rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("analysis", [odyn.simulate, odyn.kinematics, odyn.statics,
+                                      odyn.quasi_statics, odyn.modes, odyn.linearize,
+                                      odyn.check, odyn.assemble])
+def test_an_analysis_of_something_that_is_not_a_model_says_so(analysis):
+    with pytest.raises(TypeError, match="model: expected an odyn.Model or odyn.PlanarModel"):
+        analysis("engine.json")
+
+
+@pytest.mark.parametrize("orientation", [[2, 0, 0, 0], [0.5, 0.5, 0.5, 0.4]])
+def test_an_orientation_that_is_not_a_unit_quaternion_is_refused(orientation):
+    # It was scaled to one silently; a rounded unit quaternion still passes.
+    m = odyn.Model()
+    with pytest.raises(odyn.SceneError, match=r"body 'a'.orientation: expected a unit quaternion"):
+        m.add_body(name="a", mass=1.0, inertia=[1, 1, 1], orientation=orientation)
+    m.add_body(name="b", mass=1.0, inertia=[1, 1, 1], orientation=[0.7071, 0, 0, 0.7071])
+    with pytest.raises(odyn.SceneError, match=r"point 'p'.orientation: expected a unit"):
+        m.add_point("p", "b", orientation=orientation)
+
+
 # (kind, how the scene dict is spoiled, the words the error must hold)
 def _set(path, value):
     def spoil(d):
