@@ -30,6 +30,97 @@ def scene_dict():
         return json.load(f)
 
 
+def pendulum():
+    m = odyn.Model()
+    m.add_body(name="bob", mass=1.0, inertia=[1e-3, 1e-3, 1e-3], position=[1, 0, 0])
+    m.add_revolute(name="hinge", body_a="ground", on_a=odyn.frame([0, 0, 0], [0, 0, 1]),
+                   body_b="bob", on_b=odyn.frame([-1, 0, 0], [0, 0, 1]))
+    m.add_gravity(name="gravity", acceleration=[0, -9.81, 0])
+    return m
+
+
+def with_force(function):
+    """A pendulum with a point force given by `function`, run for 0.01 s."""
+    m = pendulum()
+    m.add_point_force(name="push", body="bob", force=function)
+    return odyn.simulate(m, t_end=0.01)
+
+
+NAN = float("nan")
+# (kind, an action on the Python API, the exception, the words its message must hold)
+BAD_MODELS = [
+    ("a mass of zero", lambda: odyn.Model().add_body(name="a", mass=0.0, inertia=[1, 1, 1]),
+     odyn.SceneError, ["body 'a'.mass", "positive", "0"]),
+    ("a mass of NaN", lambda: odyn.Model().add_body(name="a", mass=NAN, inertia=[1, 1, 1]),
+     odyn.SceneError, ["body 'a'.mass", "finite", "nan"]),
+    ("an inertia no body has", lambda: odyn.Model().add_body(name="a", mass=1, inertia=[1, 1, 5]),
+     odyn.SceneError, ["triangle inequality", "(1 1 5)"]),
+    ("an asymmetric inertia tensor", lambda: odyn.Model().add_body(
+        name="a", mass=1, inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]),
+     odyn.SceneError, ["body 'a'", "symmetric"]),
+    ("an indefinite inertia tensor", lambda: odyn.Model().add_body(
+        name="a", mass=1, inertia=[[1, 2, 0], [2, 1, 0], [0, 0, 1]]),
+     odyn.SceneError, ["body 'a'", "positive definite"]),
+    ("an empty name", lambda: odyn.Model().add_body(name="", mass=1, inertia=[1, 1, 1]),
+     odyn.SceneError, ["name", "non-empty"]),
+    ("a body named ground", lambda: odyn.Model().add_body(name="ground", mass=1,
+                                                           inertia=[1, 1, 1]),
+     odyn.SceneError, ["'ground' is already used"]),
+    ("a name used twice", lambda: pendulum().add_body(name="bob", mass=1, inertia=[1, 1, 1]),
+     odyn.SceneError, ["'bob' is already used"]),
+    ("a joint on an unknown body", lambda: pendulum().add_revolute(
+        name="h2", body_a="ground", body_b="bobb"),
+     odyn.SceneError, ["revolute 'h2'.body_b", "no body named 'bobb'", "ground, bob"]),
+    ("a misspelled keyword", lambda: pendulum().add_revolute(name="h2", body_a="ground",
+                                                             body_bb="bob"),
+     TypeError, ["body_bb"]),
+    ("a zero axis", lambda: pendulum().add_revolute(
+        name="h2", body_a="ground", on_a=odyn.frame([0, 0, 0], [0, 0, 0]), body_b="bob"),
+     odyn.SceneError, ["revolute 'h2'.on_a.axis", "zero-length"]),
+    ("a reference parallel to the axis", lambda: pendulum().add_revolute(
+        name="h2", body_a="ground", on_a=odyn.frame([0, 0, 0], [0, 0, 1], [0, 0, 1]),
+        body_b="bob"),
+     odyn.SceneError, ["h2", "parallel to its axis"]),
+    ("an axis with NaN", lambda: pendulum().add_revolute(
+        name="h2", body_a="ground", on_a=odyn.frame([0, 0, 0], [0, NAN, 1]), body_b="bob"),
+     odyn.SceneError, ["revolute 'h2'.on_a.axis[1]", "finite"]),
+    ("a velocity_given of 5 flags", lambda: odyn.Model().add_body(
+        name="a", mass=1, inertia=[1, 1, 1], velocity_given=[True] * 5),
+     odyn.SceneError, ["velocity_given", "6 booleans"]),
+    ("a driver of an unknown joint", lambda: pendulum().add_revolute_driver(
+        name="motor", joint="hindge", motion=odyn.constant_velocity(1.0)),
+     odyn.SceneError, ["revolute_driver 'motor'.joint", "'hindge'"]),
+    ("a motion that is not one", lambda: pendulum().add_revolute_driver(
+        name="motor", joint="hinge", motion=5),
+     odyn.SceneError, ["'motor'.motion", "expected a motion"]),
+    ("a motion with NaN", lambda: pendulum().add_revolute_driver(
+        name="motor", joint="hinge", motion=odyn.constant_velocity(NAN)),
+     odyn.SceneError, ["'motor'.motion.rate", "finite"]),
+    ("an event on an unknown point", lambda: pendulum().add_event(
+        "e", point=("rim", "position", "x")),
+     odyn.SceneError, ["event 'e'.point", "no point named 'rim'"]),
+    ("a force function returning NaN", lambda: with_force(lambda t, b: (NAN, 0.0, 0.0)),
+     ValueError, ["point_force 'push'", "non-finite"]),
+    ("a force function returning two numbers", lambda: with_force(lambda t, b: (1.0, 2.0)),
+     TypeError, ["point_force 'push'", "3 numbers"]),
+    ("a free mechanism in a kinematic analysis", lambda: odyn.kinematics(pendulum(), t_end=0.1),
+     odyn.ModelError, ["fully driven", "1 degree of freedom", "its drivers: none"]),
+    ("a static tolerance of zero", lambda: odyn.statics(pendulum(), tolerance=0.0),
+     odyn.SceneError, ["tolerance", "positive"]),
+    ("an unknown reaction", lambda: odyn.simulate(pendulum(), t_end=0.01).reaction("hindge"),
+     KeyError, ["hindge", "constraints: hinge"]),
+]
+
+
+@pytest.mark.parametrize("kind, action, exception, words", BAD_MODELS,
+                         ids=[case[0] for case in BAD_MODELS])
+def test_bad_models_are_refused_by_name(kind, action, exception, words):
+    with pytest.raises(exception) as error:
+        action()
+    for word in words:
+        assert word in str(error.value), (kind, str(error.value))
+
+
 # (kind, the run's keyword arguments, the words its error must hold)
 BAD_RUN_SETTINGS = [
     ("a relative tolerance of 100% or more", {"rtol": 1e300}, ["rtol", "below 1"]),
