@@ -46,6 +46,14 @@ def with_force(function):
     return odyn.simulate(m, t_end=0.01)
 
 
+def contradicted():
+    """The pendulum with a second hinge about x, 0.5 m along z: no pose meets both."""
+    m = pendulum()
+    m.add_revolute(name="second hinge", body_a="ground", on_a=odyn.frame([0, 0, 0.5], [1, 0, 0]),
+                   body_b="bob", on_b=odyn.frame([-1, 0, 0.5], [0, 0, 1]))
+    return m
+
+
 NAN = float("nan")
 # (kind, an action on the Python API, the exception, the words its message must hold)
 BAD_MODELS = [
@@ -109,6 +117,8 @@ BAD_MODELS = [
      odyn.SceneError, ["tolerance", "positive"]),
     ("an unknown reaction", lambda: odyn.simulate(pendulum(), t_end=0.01).reaction("hindge"),
      KeyError, ["hindge", "constraints: hinge"]),
+    ("contradictory joints", lambda: odyn.simulate(contradicted(), t_end=0.01),
+     odyn.AssemblyError, ["could not be satisfied", "at joint 'second hinge'", "axes"]),
 ]
 
 
@@ -234,6 +244,7 @@ def test_scenes_are_refused_with_the_place(kind, spoil, words, tmp_path):
 
 SCENE_TEXTS = [
     ("a list at the top", lambda text: "[" + text + "]", ["scene: expected a JSON object"]),
+    ("a file cut in half", lambda text: text[:len(text) // 2], ["not valid JSON", "line"]),
     ("a key given twice", lambda text: text.replace('"mass": 1.399', '"mass": 1.399, "mass": 2'),
      ["'mass' appears twice", "remove one"]),
     ("nesting thousands deep", lambda text: text[:-2] + ', "x": ' + "[" * 100000
