@@ -137,9 +137,13 @@ class Result:
     statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
     early); summary: the same as a dict, with the assembly report; statics: a static
     equilibrium's summary (odyn.statics); kinematics: a kinematic analysis's (odyn.kinematics).
+    A run that stopped early (the rows so far, an exception's `result`) says why:
+    `interrupted` is True after Ctrl-C, `error` holds the message of the error that stopped it
+    ("SolverError: at t = ..."), and `complete` is False for both.
     """
 
-    def __init__(self, data: Dict[str, Any], interrupted: bool = False) -> None:
+    def __init__(self, data: Dict[str, Any], interrupted: bool = False,
+                 error: Optional[str] = None) -> None:
         self._data = data
         self.t: np.ndarray = data["t"]
         self.q: np.ndarray = data["q"]
@@ -159,6 +163,7 @@ class Result:
         self.assembly: Optional[Dict[str, Any]] = data.get("assembly") or (
             self.summary["assembly"] if self.summary else None)
         self.interrupted = interrupted
+        self.error: Optional[str] = error
         self._bodies: List[str] = list(data["bodies"])
         self._points: Dict[str, Tuple[int, List[float]]] = dict(data.get("points", {}))
         # The markers with axes: name -> their axes in their body's axes.
@@ -418,9 +423,15 @@ class Result:
         e = self.total_energy
         return float(np.max(np.abs(e - e[0]))) if len(e) else 0.0
 
+    @property
+    def complete(self) -> bool:
+        """False for the rows of a run that Ctrl-C or an error stopped early."""
+        return not self.interrupted and self.error is None
+
     def __repr__(self) -> str:
         end = f"{self.t[-1]:g}" if len(self.t) else "-"
-        note = ", interrupted" if self.interrupted else ""
+        note = (", interrupted" if self.interrupted else
+                f", stopped by {self.error.split(':')[0]}" if self.error is not None else "")
         return f"<odyn.Result: {len(self.t)} outputs, t = 0 .. {end} s{note}>"
 
 
@@ -621,9 +632,9 @@ def finished_run(model: BaseModel, data: Dict[str, Any]) -> Result:
         result = Result(data)
         _warn(result, depth=1)
         return result
-    result = Result(data, interrupted=True)
     if isinstance(error, KeyboardInterrupt):
-        raise Interrupted(result) from error
+        raise Interrupted(Result(data, interrupted=True)) from error
+    result = Result(data, error=f"{type(error).__name__}: {error}")
     try:
         error.result = result
     except AttributeError:

@@ -373,4 +373,7 @@ def test_an_exception_in_a_user_function_names_its_element_and_time():
     assert len(notes) == 1 and "point_force 'push'" in notes[0], notes
     time = float(notes[0].split("at t = ")[1].split(" s")[0])
     assert 0.05 < time <= 0.052
-    assert 5 <= len(error.value.result) <= 7  # the rows before it are kept
+    partial = error.value.result  # the rows before it are kept, and say why they end there
+    assert 5 <= len(partial) <= 7 and partial.error == "ZeroDivisionError: boom"
+    assert not partial.complete and not partial.interrupted
+    assert "stopped by ZeroDivisionError" in repr(partial)

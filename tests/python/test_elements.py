@@ -609,7 +609,8 @@ def test_python_callable_errors_reach_the_caller_with_partial_results():
     with pytest.raises(ZeroDivisionError, match="boom") as info:
         odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.01)
     partial = info.value.result
-    assert partial.interrupted and 5 <= len(partial) <= 7
+    assert 5 <= len(partial) <= 7 and not partial.complete and not partial.interrupted
+    assert partial.error == "ZeroDivisionError: boom"
 
     m = spring_on_rail("tsda")
     m.add_point_force(name="wrong", body="block", force=lambda t, b: (1.0, 2.0))
