@@ -8,7 +8,7 @@ import os
 import sys
 import time
 import warnings
-from typing import List, NoReturn, Optional, Tuple
+from typing import Any, List, NoReturn, Optional, Tuple
 
 import numpy as np
 
@@ -171,8 +171,17 @@ def summary_lines(scene: Scene, result: Result, settings: dict, wall: float) -> 
         lines.append(f"  largest residuals: |Phi| {np.max(result.phi_norm):.2e}, "
                      f"|Phi_q v + Phi_t| {np.max(result.phid_norm):.2e}")
         e = result.total_energy
-        lines.append(f"  energy (kinetic + potential): {e[0]:.6g} J at t = 0, {e[-1]:.6g} J "
-                     f"at the end; largest drift {result.energy_drift():.3g} J")
+        working = working_elements(scene.model)
+        energy = (f"  energy (kinetic + potential): {e[0]:.6g} J at t = 0, {e[-1]:.6g} J "
+                  "at the end; ")
+        if working:
+            named = ", ".join(working[:4]) + (f" and {len(working) - 4} more"
+                                               if len(working) > 4 else "")
+            lines.append(energy + f"it changes by up to {result.energy_drift():.3g} J "
+                         f"through the work of {named} (not an error)")
+        else:
+            lines.append(energy + f"largest drift {result.energy_drift():.3g} J (every force "
+                         "has a potential here, so this is the integration's error)")
         final = scene.columns(result)
         shown = [f"{k} {v[-1]:.6g}" for k, v in final.items() if k != "t"][:6]
         if shown:
@@ -206,6 +215,44 @@ def _settings(args: argparse.Namespace, scene: Scene, kind: str) -> dict:
     elif args.rtol is not None or args.atol is not None:
         settings["adaptive"] = True  # as the C++ examples: tolerances turn on error control
     return settings
+
+
+# Force types whose forces all have a potential in the model's energy, unless one of the
+# parameters named gives them a damper, an actuator, a law of one's own or friction.
+_CONSERVATIVE_UNLESS = {
+    "gravity": (), "tsda": ("damping", "actuator"), "rsda": ("damping", "actuator"),
+    "bushing": ("damping", "law"), "revolute_limit": ("dissipation",),
+    "translational_limit": ("dissipation",),
+    **{contact: ("dissipation", "friction") for contact in (
+        "sphere_plane", "sphere_sphere", "box_plane", "capsule_plane", "circle_line",
+        "circle_circle", "rectangle_line", "capsule_line")},
+}
+
+
+def _nonzero(value: Any) -> bool:
+    if value is None:
+        return False
+    if isinstance(value, (int, float)):
+        return value != 0
+    if isinstance(value, (list, tuple)):
+        return any(_nonzero(v) for v in value)
+    return True  # a function, or a motion
+
+
+def working_elements(model: Any) -> List[str]:
+    """The elements whose work the kinetic + potential energy leaves out: drivers, Python
+    constraints (which may move with time), dampers, actuators, friction, and loads without a
+    potential (point loads, Python forces, a module's forces)."""
+    out = []
+    for name in model.element_names:
+        kind = model.element_type(name)
+        category = _schema.KNOWN[model.space].get(kind, {}).get("category")
+        if category == "driver" or kind == "user_constraint":
+            out.append(name)
+        elif category != "joint" and (kind not in _CONSERVATIVE_UNLESS or any(
+                _nonzero(model.element(name).get(key)) for key in _CONSERVATIVE_UNLESS[kind])):
+            out.append(name)
+    return out
 
 
 def _probe_writable(option: str, given: str, path: str) -> None:

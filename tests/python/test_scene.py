@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import odyn
-from conftest import ENGINE_SCENE
+from conftest import ENGINE_SCENE, ROOT
 
 
 @pytest.fixture()
@@ -197,3 +197,27 @@ def test_a_scene_without_an_integrator_takes_simulates_default(engine_dict, tmp_
                              capture_output=True, text=True)
         assert run.returncode == 0, run.stderr
         assert run.stdout.splitlines()[1].startswith("auto" if removed else "generalized-alpha")
+
+
+def test_the_energy_line_tells_work_from_drift(tmp_path, capsys):
+    """The summary's energy line names the elements whose work changes kinetic + potential
+    energy (a driven, damped run is not drifting), and calls the change a drift only where
+    every force has a potential."""
+    from odyn import cli
+    assert cli.main(["run", str(ROOT / "examples" / "slider_crank_planar.json"), "--t-end",
+                     "0.02"]) == 0
+    assert "through the work of load, gas force (not an error)" in capsys.readouterr().out
+    m = odyn.PlanarModel()
+    m.add_body(name="bar", mass=1.0, inertia=1 / 12, position=[0.5, 0])
+    m.add_revolute(name="pivot", body_a="ground", body_b="bar", on_b=odyn.frame([-0.5, 0]))
+    m.add_gravity(name="gravity", acceleration=[0, -9.81])
+    m.add_rsda(name="spring", body_a="ground", body_b="bar", stiffness=5.0)
+    path = tmp_path / "pendulum.json"
+    odyn.save(m, path)
+    assert cli.main(["run", str(path), "--t-end", "0.1"]) == 0
+    printed = capsys.readouterr().out
+    assert "largest drift" in printed and "this is the integration's error" in printed
+    m.add_tsda(name="damper", body_a="ground", point_a=[1, 1], body_b="bar", damping=0.5)
+    odyn.save(m, path)
+    assert cli.main(["run", str(path), "--t-end", "0.1"]) == 0
+    assert "through the work of damper (not an error)" in capsys.readouterr().out
