@@ -1,6 +1,8 @@
-"""Bad input that once slipped through (accepted silently, or answered with a traceback or a
-vague message): each kind gets a specific error naming the setting or the place, the bad value
-and what to do, through the Python API, scene files and the command line alike."""
+"""The bad-input catalogue: each kind of bad input gets a specific error naming the element,
+setting or place, the bad value and what to do, through the Python API, scene files and the
+command line alike, and keeps what was computed so far. Many of these once slipped through
+(accepted silently, or answered with a traceback or a vague message; issue 28 lists them).
+tests/python/test_fuzz.py fuzzes the scene loader beyond these kinds."""
 
 import json
 import math
