@@ -503,10 +503,11 @@ RunSummary start_run(const Model& model, Workspace<Model>& ws, const DynamicsSet
                         " s is below what double precision resolves at t = " + to_text(ws.t) +
                         " s, so time would not advance; give a step of at least " + to_text(least) +
                         " s");
-  if (!(s.rtol < 1.0))
+  // rtol = 1 (with a large atol) has a use: an adaptive method that never rejects a step.
+  if (!(s.rtol <= 1.0))
     throw ModelError("dynamics", "rtol " + to_text(s.rtol) +
-                                     " is a relative error of 100% or more, which controls "
-                                     "nothing; give a fraction below 1 (1e-6 by default)");
+                                     " is a relative error above 100%, which controls nothing; "
+                                     "give a fraction of at most 1 (1e-6 by default)");
   RunSummary summary;
   AssemblySettings assembly = s.assembly;
   assembly.linear_solver = s.linear_solver;

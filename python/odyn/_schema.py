@@ -64,12 +64,13 @@ def check_number(x: Any, where: str, *, minimum: Optional[float] = None,
 
 
 def check_tolerance(x: Any, where: str, *, relative: bool = False) -> float:
-    """A positive tolerance; a relative one (rtol, newton_rtol) also below 1, since an error of
-    100% or more of the value controls nothing."""
+    """A positive tolerance; a relative one (rtol, newton_rtol) also at most 1, since an error
+    above 100% of the value controls nothing (1, with a large atol, makes an adaptive method
+    that never rejects a step)."""
     value = check_number(x, where, positive=True)
-    if relative and not value < 1.0:
-        fail(where, f"a relative tolerance of {value:g} (100% or more) controls nothing; give a "
-             "fraction below 1, such as 1e-6")
+    if relative and not value <= 1.0:
+        fail(where, f"a relative tolerance of {value:g} (above 100%) controls nothing; give a "
+             "fraction of at most 1, such as 1e-6")
     return value
 
 
