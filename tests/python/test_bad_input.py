@@ -2,7 +2,8 @@
 setting or place, the bad value and what to do, through the Python API, scene files and the
 command line alike, and keeps what was computed so far. Many of these once slipped through
 (accepted silently, or answered with a traceback or a vague message; issue 28 lists them).
-tests/python/test_fuzz.py fuzzes the scene loader beyond these kinds."""
+tests/python/test_fuzz.py fuzzes the scene loader beyond these kinds; an exception raised in a
+user function is tested in test_elements.py."""
 
 import json
 import math
@@ -357,25 +358,3 @@ def test_a_table_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
     monkeypatch.undo()
     odyn.scene.write_table(table, path)
     assert path.read_text().count("\n") == 1001
-
-
-def test_an_exception_in_a_user_function_names_its_element_and_time():
-    # The exception stays the user's (its type and message), with a note saying where it rose.
-    m = falling_stone()
-
-    def push(t, body):
-        if t > 0.05:
-            raise ZeroDivisionError("boom")
-        return (0.0, 0.0, 0.0)
-    m.add_point_force(name="push", body="stone", force=push)
-    with pytest.raises(ZeroDivisionError, match="boom") as error:
-        odyn.simulate(m, t_end=0.2, integrator="generalized-alpha", step=1e-3,
-                      output_interval=0.01)
-    notes = getattr(error.value, "__notes__", [])
-    assert len(notes) == 1 and "point_force 'push'" in notes[0], notes
-    time = float(notes[0].split("at t = ")[1].split(" s")[0])
-    assert 0.05 < time <= 0.052
-    partial = error.value.result  # the rows before it are kept, and say why they end there
-    assert 5 <= len(partial) <= 7 and partial.error == "ZeroDivisionError: boom"
-    assert not partial.complete and not partial.interrupted
-    assert "stopped by ZeroDivisionError" in repr(partial)

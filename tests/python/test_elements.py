@@ -608,9 +608,15 @@ def test_python_callable_errors_reach_the_caller_with_partial_results():
     m.add_point_force(name="bad", body="block", force=bad)
     with pytest.raises(ZeroDivisionError, match="boom") as info:
         odyn.simulate(m, t_end=1.0, step=1e-3, output_interval=0.01)
-    partial = info.value.result
+    # The exception stays the user's (its type and message), with a note saying where it rose.
+    notes = getattr(info.value, "__notes__", [])
+    assert len(notes) == 1 and "point_force 'bad'" in notes[0], notes
+    time = float(notes[0].split("at t = ")[1].split(" s")[0])
+    assert 0.05 < time <= 0.052  # generalized-alpha's steps of 1e-3
+    partial = info.value.result  # the rows before it are kept, and say why they end there
     assert 5 <= len(partial) <= 7 and not partial.complete and not partial.interrupted
     assert partial.error == "ZeroDivisionError: boom"
+    assert "stopped by ZeroDivisionError" in repr(partial)
 
     m = spring_on_rail("tsda")
     m.add_point_force(name="wrong", body="block", force=lambda t, b: (1.0, 2.0))
