@@ -5,12 +5,14 @@
 #   bash scripts/setup.sh --no-package    the dependencies only (test.sh builds the package
 #                                         beside its C++ builds)
 #   bash scripts/setup.sh --tests ...     also what scripts/test.sh needs beyond that: clang, whose
-#                                         sanitizers build the test suite
+#                                         sanitizers build the test suite, and Sphinx
+#   bash scripts/setup.sh --docs ...      also what scripts/docs.sh needs: Sphinx with MyST
 # ODYN_PACKAGE_CXX=<compiler> builds the Python package and the engine's module with that compiler
 # (default: CMake's choice, g++); scripts/test.sh uses clang++-15, several times faster on them.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 package=1
+docs=0
 packages=(
   build-essential cmake ninja-build ccache pkg-config git ca-certificates
   libeigen3-dev libsuitesparse-dev catch2 libbenchmark-dev
@@ -19,7 +21,8 @@ packages=(
 for arg in "$@"; do
   case $arg in
     --no-package) package=0 ;;
-    --tests) packages+=(clang-15) ;;  # its ASan and UBSan runtimes come with it
+    --tests) packages+=(clang-15); docs=1 ;;  # its ASan and UBSan runtimes come with it
+    --docs) docs=1 ;;
     *) echo "setup.sh: unknown option $arg (see the comment at its top)" >&2; exit 1 ;;
   esac
 done
@@ -62,6 +65,12 @@ fi
 if ! .venv/bin/python -c 'import scikit_build_core, pybind11' >/dev/null 2>&1; then
   echo "setup.sh: installing scikit-build-core pybind11 into .venv"
   .venv/bin/python -m pip install -q --disable-pip-version-check scikit-build-core pybind11
+fi
+
+# The documentation site's builder (scripts/docs.sh).
+if ((docs)) && ! .venv/bin/python -c 'import sphinx, myst_parser' >/dev/null 2>&1; then
+  echo "setup.sh: installing sphinx myst-parser into .venv"
+  .venv/bin/python -m pip install -q --disable-pip-version-check "sphinx>=7.2" "myst-parser>=2"
 fi
 
 ((package)) || exit 0

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Full check: ASan/UBSan build + Catch2 tests (allocation count included), the Release engine
-# example, install + downstream consumer, the Python package and its tests. Exits non-zero on a
-# failure.
+# example, install + downstream consumer, the Python package and its tests (the documentation's
+# examples included), the documentation site. Exits non-zero on a failure.
 # The Catch2 suite's long runs (tests/CMakeLists.txt, ODYN_LONG_RUN_TESTS) are compiled at -O1
 # without the sanitizers, its other files at -O0 with them.
 set -euo pipefail
@@ -173,5 +173,8 @@ finish "$python_pid" "$python_log" "pip install . (the odyn Python package)"
 
 section "Python tests"
 finish "$pytest_pid" "$pytest_log" "the Python tests"
+
+section "Documentation site (scripts/docs.sh: warnings are errors)"
+bash scripts/docs.sh
 
 section "All checks passed"

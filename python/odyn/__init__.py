@@ -1,6 +1,6 @@
 """odyn: multibody dynamics (rigid bodies, joints, drivers, forces; assembly; dynamics with
 generalized-alpha, HHT or Dormand-Prince, by name), with the C++ library's spatial and planar
-elements compiled in.
+elements compiled in::
 
     import odyn
     m = odyn.Model()

@@ -1,6 +1,6 @@
-"""Writes what comes from the element descriptions of the compiled core: the ``add_*`` methods of
-`odyn.Model` and `odyn.PlanarModel` (python/odyn/_elements.py) and the element reference
-(docs/elements.md).
+"""Writes what comes from the element descriptions of the compiled core and the scene loader's
+tables: the ``add_*`` methods of `odyn.Model` and `odyn.PlanarModel` (python/odyn/_elements.py),
+the element reference (docs/elements.md) and the scene-file reference (docs/scene-files.md).
 
     python -m odyn._generate [--root REPOSITORY] [--check]
 
@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Mapping, Tuple
+from typing import Any, Dict, List, Mapping, Sequence, Tuple
 
 from . import _schema
 
@@ -225,33 +226,49 @@ def elements_markdown() -> str:
         "An element type that is not odyn's (a law of one machine, say) needs no change to "
         "odyn: write its header as above, then a pybind11 module that compiles models with it. "
         "`examples/python/odyn_engine/` is one, the engine's gas force, built outside odyn "
-        "against the installed package:",
+        "against the installed package. Its `engine_models.hpp` names the model types, "
+        "each with just the element types an engine needs (the elements written in Python "
+        "come with every model):",
+        "",
+        "```cpp",
+        "using Spatial =",
+        "    odyn::python::SpatialModelOf<sp::Revolute, sp::Spherical, sp::Universal, "
+        "sp::Translational,",
+        "                                 sp::Gravity, sp::Rsda, sp::PointForce, sp::PointTorque, "
+        "sp::Tsda,",
+        "                                 engine::GasForce>;",
+        "```",
+        "",
+        "(`SpatialModelWith<engine::GasForce>` would hold odyn's whole catalogue and the gas "
+        "force; the planar twins are `PlanarModelOf` and `PlanarModelWith`), and its "
+        "`odyn_engine.cpp` binds them:",
         "",
         "```cpp",
         "#include <odyn/python/module.hpp>",
-        "#include \"my_force.hpp\"",
         "",
-        "PYBIND11_MODULE(my_models, m) {",
-        "  // odyn's catalogue and MyForce; in the plane, just a revolute joint and MyPlanarForce",
-        "  using Spatial = odyn::python::SpatialModelWith<MyForce>;",
-        "  using Planar = odyn::python::PlanarModelOf<odyn::planar::Revolute, MyPlanarForce>;",
-        "  odyn::python::bind_models<Spatial, Planar>(m);",
+        "#include \"engine_models.hpp\"",
+        "",
+        "PYBIND11_MODULE(odyn_engine, m) {",
+        "  namespace python = odyn::python;",
+        "  // ...",
+        "  python::use_odyn_errors();",
+        "  python::bind_model_types<engine_module::Spatial, engine_module::Planar>(m);",
+        "  using SpatialBox = python::ModelBox<engine_module::Spatial>;",
+        "  python::analysis::bind_dynamics<SpatialBox>(m);",
+        "  python::analysis::bind_kinematics<SpatialBox>(m);",
+        "  engine_module::bind_planar_analyses(m);  // planar_analyses.cpp",
         "}",
         "```",
         "",
-        "`SpatialModelWith<...>` holds odyn's whole catalogue and the given types; "
-        "`SpatialModelOf<...>` (and the planar twins) holds just the given types (and the "
-        "elements written in Python). The analyses' instantiations dominate the build either "
-        "way (minutes of CPU each with GCC 12; docs/benchmarks.md, \"Compile time\"). "
-        "`bind_models` compiles all of them; a module may instead call "
-        "`odyn::python::use_odyn_errors()` and `bind_model_types<Spatial, Planar>(m)`, then "
-        "bind for each model type only the analyses it is run with "
-        "(`include/odyn/python/analyses.hpp`): `bind_dynamics` (assembly and the dynamic "
-        "analysis, every integrator in both coordinates), `bind_kinematics` (the kinematic "
-        "analysis and the model report) and `bind_statics` (static equilibrium, quasi-statics, "
-        "modes and linearization, which cost GCC about as much as the dynamics). "
-        "`examples/python/odyn_engine/` binds the first two, in two units that two cores "
-        "compile side by side; odyn refuses the others on its models by name.",
+        "The analyses' instantiations dominate a module's build (minutes of CPU each with "
+        "GCC 12; docs/benchmarks.md, \"Compile time\"), so a module binds for each model type "
+        "only the analyses it is run with (`include/odyn/python/analyses.hpp`): "
+        "`bind_dynamics` (assembly and the dynamic analysis, every integrator in both "
+        "coordinates), `bind_kinematics` (the kinematic analysis and the model report) and "
+        "`bind_statics` (static equilibrium, quasi-statics, modes and linearization, which cost "
+        "GCC about as much as the dynamics); `odyn::python::bind_models<Spatial, Planar>(m)` "
+        "binds everything in one unit. odyn_engine binds the first two, in two units that two "
+        "cores compile side by side; odyn refuses the others on its models by name.",
         "",
         "The odyn package carries its C++ headers and CMake package, so the module builds "
         "against it as `examples/python/odyn_engine/` does: a `CMakeLists.txt` with "
@@ -303,9 +320,121 @@ def elements_markdown() -> str:
     return "\n".join(out) + "\n"
 
 
+def _keys_table(place: str, required: Sequence[str] = ()) -> List[str]:
+    from . import scene
+    rows = ["| key | meaning |", "|---|---|"]
+    for key, doc in scene.KEYS[place].items():
+        mark = " (required)" if key in required else ""
+        rows.append(f"| `{key}` | {_cell(doc)}{mark} |")
+    return rows
+
+
+def _compact_json(value: Any) -> str:
+    """JSON indented by objects, with each list of numbers or strings on one line."""
+    text = json.dumps(value, indent=2)
+    return re.sub(r"\[\s+([^\[\]{}]*?)\s+\]",
+                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text)
+
+
+def scene_markdown() -> str:
+    """The source of docs/scene-files.md: the scene format, from the loader's own tables."""
+    from . import scene
+    out = [
+        "# Scene files",
+        "",
+        "<!-- Generated by `python -m odyn._generate` from the scene loader's tables "
+        "(python/odyn/scene.py, python/odyn/_schema.py); do not edit. -->",
+        "",
+        "A scene file is a whole model in JSON: its bodies, joints, drivers and forces, the "
+        "analysis to run with its settings, the columns to write and the figures to draw. "
+        "`odyn run SCENE` runs it ([command-line.md](command-line.md)), `odyn.load(path)` reads "
+        "it into Python and `odyn.save(model_or_scene, path)` writes one. Loading checks every "
+        "field and names the place of an error (`joints[2].on_a.axis: zero-length vector; "
+        "expected a non-zero direction`); a key this page does not list is an error, and so is a "
+        "key given twice.",
+        "",
+        "A pendulum swinging for two seconds, with its hinge's reaction written and drawn:",
+        "",
+        "```json",
+        _compact_json(EXAMPLE_SCENE),
+        "```",
+        "",
+        "## Top level",
+        "",
+        *_keys_table("scene", scene.REQUIRED_KEYS["scene"]),
+        "",
+        "## Bodies",
+        "",
+        "Each entry of `bodies`. The defaults are zero (an identity orientation); `name`, and "
+        "`mass` and `inertia` or `parts`, are required.",
+        "",
+        *_keys_table("bodies"),
+        "",
+    ]
+    out += ["## Joints, drivers and forces", "",
+            "Each entry has a `type` and a `name`, and the parameters of its type, named as in "
+            "C++ and in Python's `add_<type>` methods: [elements.md](elements.md) lists each "
+            "type's parameters, defaults and outputs. The types each section takes:", ""]
+    for space in SPACES:
+        out += [f"**{space.capitalize()}**", "", "| section | types |", "|---|---|"]
+        # odyn's own types: a module of one's own, if one is loaded, adds its types elsewhere.
+        own = list(_schema.DESCRIPTIONS[space])
+        for section, types in scene.space_sections(space, own).items():
+            links = ", ".join(f"[`{t}`](elements.md#{space}-{t.replace('_', '-')})"
+                              for t in types)
+            out.append(f"| `{section}` | {links} |")
+        out.append("")
+    out += ["Functions written in Python (`user_force`, `user_constraint`) cannot be held in a "
+            "file; a model that has them is built in Python.", "",
+            "## Analysis", "",
+            "`analysis.type` names the analysis; each takes the settings marked for it "
+            "(another is refused, with the list of those it takes). `t_end` and "
+            "`output_interval` apply to the timed ones: " + ", ".join(scene.TIMED) + ".", "",
+            "| key | meaning | " + " | ".join(scene.ANALYSES) + " |",
+            "|---|---|" + "---|" * len(scene.ANALYSES)]
+    for key, doc in scene.KEYS["analysis"].items():
+        takes = [key == "type" or key in scene.ANALYSIS_DEFAULTS and kind in scene.TIMED
+                 or key in scene.ANALYSES[kind] for kind in scene.ANALYSES]
+        out.append(f"| `{key}` | {_cell(doc)} | " + " | ".join("✓" if t else "" for t in takes)
+                   + " |")
+    out += ["", "## Output columns", "",
+            "Each entry of `outputs` is one column of the table `odyn run --out` writes (CSV or "
+            "NumPy's .npz), told apart by the key it has of `body`, `reaction`, `point`, "
+            "`element` and `state`; an entry with none of them is a global quantity.", ""]
+    for form in ("body", "reaction", "point", "element", "state", "global"):
+        place = f"outputs.{form}"
+        out += [f"### {form.capitalize()} columns", "",
+                *_keys_table(place, scene.REQUIRED_KEYS[place]), ""]
+    out += ["## Figures", "",
+            "Each entry of `figures` is a figure of one or more output columns against time.",
+            "", *_keys_table("figures", scene.REQUIRED_KEYS["figures"])]
+    return "\n".join(out) + "\n"
+
+
+#: The example at the top of docs/scene-files.md (a test loads and runs it).
+EXAMPLE_SCENE: Dict[str, Any] = {
+    "odyn": 1,
+    "description": "a pendulum of 1 m",
+    "bodies": [{"name": "bob", "mass": 1.0, "inertia": [1e-3, 1e-3, 1e-3],
+                "position": [1.0, 0.0, 0.0]}],
+    "joints": [{"type": "revolute", "name": "hinge", "body_a": "ground",
+                "on_a": {"point": [0, 0, 0], "axis": [0, 0, 1]}, "body_b": "bob",
+                "on_b": {"point": [-1, 0, 0], "axis": [0, 0, 1]}}],
+    "forces": [{"type": "gravity", "name": "gravity", "acceleration": [0, -9.81, 0]}],
+    "analysis": {"t_end": 2.0, "output_interval": 0.01, "integrator": "dop853", "rtol": 1e-8,
+                 "atol": 1e-8},
+    "outputs": [{"name": "x", "body": "bob", "quantity": "position", "component": "x"},
+                {"name": "hinge_fy", "reaction": "hinge", "quantity": "force",
+                 "component": "y"}],
+    "figures": [{"file": "hinge.png", "y": "hinge_fy", "title": "The hinge's vertical force",
+                 "ylabel": "N"}],
+}
+
+
 def outputs(root: Path) -> Dict[Path, str]:
     return {root / "python" / "odyn" / "_elements.py": elements_source(),
-            root / "docs" / "elements.md": elements_markdown()}
+            root / "docs" / "elements.md": elements_markdown(),
+            root / "docs" / "scene-files.md": scene_markdown()}
 
 
 def main(argv: List[str]) -> int:

@@ -128,8 +128,8 @@ class Result:
     """Outputs of an analysis, one row per output time.
 
     Arrays: t (n), q (n x 7 nb; planar n x 3 nb), v and vdot (n x 6 nb; planar n x 3 nb),
-    lambda_ (n x m), kinetic_energy, potential_energy, total_energy, phi_norm (|Phi|),
-    phid_norm (|Phi_q v + Phi_t|).
+    ``lambda_`` (n x m), kinetic_energy, potential_energy, total_energy, phi_norm (``|Phi|``),
+    phid_norm (``|Phi_q v + Phi_t|``).
     By name: body(name), point(name), relative(point, to, axes), reaction(joint, side, axes),
     multipliers(joint), output(element, name), state(element).
     events: the model's events in time order (Event: name, time, direction, terminal);
@@ -418,7 +418,7 @@ class Result:
         return np.array([e.time for e in self.events if e.name == name], dtype=float)
 
     def energy_drift(self) -> float:
-        """Largest |E(t) - E(0)| of kinetic plus potential energy (work of dampers and
+        """Largest ``|E(t) - E(0)|`` of kinetic plus potential energy (work of dampers and
         actuators included: only a conservative model keeps it at zero)."""
         e = self.total_energy
         return float(np.max(np.abs(e - e[0]))) if len(e) else 0.0

@@ -86,8 +86,6 @@ def space_sections(space: str, compiled: Optional[Sequence[str]] = None
             "forces": kept(_schema.SPACE_FORCES[space])}
 
 
-TOP_KEYS = ("odyn", "description", "space", "module", "bodies", "joints", "drivers", "forces",
-            "points", "events", "analysis", "outputs", "figures")
 ANALYSIS_DEFAULTS: Dict[str, Any] = {"t_end": 1.0, "output_interval": 1e-3}
 # Left out, integrator, rho_inf and step take simulate()'s defaults: auto at rtol = atol = 1e-6,
 # or generalized-alpha (rho_inf 0.9) when a step is given without tolerances.
@@ -124,6 +122,122 @@ GLOBAL_QUANTITIES = ("phi_norm", "phid_norm", "kinetic_energy", "potential_energ
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
 PLANAR_COMPONENTS = {"x": 0, "y": 1}
 QUATERNION_COMPONENTS = {"w": 0, "x": 1, "y": 2, "z": 3}
+
+#: Every key a scene file may hold, by place, with what it means: the loader accepts these and no
+#: others, and `python -m odyn._generate` writes docs/scene-files.md from them.
+KEYS: Dict[str, Dict[str, str]] = {
+    "scene": {
+        "odyn": "the format's version, 1 (optional)",
+        "description": "free text",
+        "space": '"spatial" (the default: 3-vectors, quaternions) or "planar" (2-vectors, '
+                 "angles, the planar elements)",
+        "module": "a module of one's own whose models compile the scene's element types "
+                  "(`odyn.modules`); left out, odyn's own catalogue",
+        "bodies": "the moving bodies, at least one; the ground is `ground`",
+        "joints": "joints, and the gears and couplers between joints, each with its `type`",
+        "drivers": "drivers, each with its `type` and parameters",
+        "forces": "forces, contacts, joint limits and joint friction, each with its `type`",
+        "points": "named points (markers) fixed on bodies: `name`, `body`, `at`, optionally "
+                  "`orientation` (see `Model.add_point`)",
+        "events": "crossings to locate: `name`, `output` or `point`, `value`, `direction`, "
+                  "`terminal` (see `Model.add_event`)",
+        "analysis": "the analysis and its settings (below); left out, a dynamic run to 1 s",
+        "outputs": "the columns written by `odyn run --out` (below)",
+        "figures": "figures drawn by `odyn run --figures DIR` (below)",
+    },
+    "bodies": {
+        "name": "a name of its own (not `ground`)",
+        "mass": "kg, positive (left out with `parts`)",
+        "inertia": "kg m^2 about the centre of mass: in space 3 principal moments in body axes "
+                   "or a 3 x 3 tensor; in the plane a number (left out with `parts`)",
+        "parts": "instead of mass and inertia, the parts odyn combines ([bodies.md](bodies.md))",
+        "position": "m, the centre of mass (with `parts`, the parts frame's origin), global",
+        "orientation": "space: a unit quaternion (w, x, y, z), body to global",
+        "angle": "plane: rad, the body's angle",
+        "linear_velocity": "m/s, global",
+        "angular_velocity": "rad/s; in space in the body's own axes",
+        "velocity_given": "booleans, one per velocity component (space: linear x y z, angular x "
+                          "y z; plane: x', y', phi'): those assembly must keep; the others it "
+                          "may change to meet the constraints",
+    },
+    "analysis": {
+        "t_end": "end time in s (default 1.0; timed analyses)",
+        "output_interval": "time between output rows in s (default 1e-3; timed analyses)",
+        "type": '"dynamic" (the default), "kinematic", "static", "quasi_static", "modes" or '
+                '"linear"',
+        "integrator": "a name of `odyn integrators`; left out, `simulate`'s choice",
+        "rho_inf": "generalized-alpha's and HHT's spectral radius at infinity, in [0, 1]",
+        "step": "the (first) step size in s",
+        "rtol": "relative error tolerance, in (0, 1]",
+        "atol": "absolute error tolerance",
+        "max_step": "the largest step in s",
+        "adaptive": "step control for generalized-alpha and HHT (true or false)",
+        "newton_rtol": "relative tolerance of the implicit integrators' Newton iterations",
+        "newton_atol": "absolute tolerance of the implicit integrators' Newton iterations",
+        "constraint_tolerance": "tolerance on the constraints' residual of a Newton step",
+        "max_iterations": "Newton iterations allowed per step or configuration (at least 1)",
+        "projection_tolerance": "explicit methods' tolerance of the projection onto the "
+                                "constraints",
+        "order": "the Adams and BDF methods' (largest) order, 1 to 6",
+        "coordinates": '"auto", "absolute" or "joint" (dynamic); "absolute" or "joint" (the '
+                       "others)",
+        "linear_solver": '"auto", "dense", "cholmod" or "klu"',
+        "max_halvings": "quasi-static load-step halvings allowed (at least 0)",
+        "find_equilibrium": "linear: linearize about the static equilibrium (true) or the "
+                            "given state",
+        "inputs": 'linear: named inputs, `{name: {"body": ..., "force": ..., "torque": ...}}`',
+        "outputs": 'linear: named outputs such as "spring.length" or "tip.velocity.x"',
+    },
+    "outputs.body": {
+        "name": "the column's name", "body": "a moving body",
+        "quantity": ", ".join(BODY_QUANTITIES) + " (planar: angle instead of orientation)",
+        "component": "x, y or z (orientation: w, x, y or z; none for a planar angle or rate)",
+    },
+    "outputs.reaction": {
+        "name": "the column's name", "reaction": "a joint or driver",
+        "side": '"b" (the default: on body_b) or "a"',
+        "axes": '"global" (the default) or "joint"', "quantity": "force or torque",
+        "component": "x, y or z (none for a planar torque)",
+    },
+    "outputs.point": {
+        "name": "the column's name", "point": "a named point",
+        "relative_to": "another named point (default: the global origin)",
+        "axes": '"global" (the default), a body or a point', "seen_from": "a body or a point "
+        "(default: the ground)", "quantity": ", ".join(POINT_QUANTITIES),
+        "component": "x, y or z",
+    },
+    "outputs.element": {
+        "name": "the column's name", "element": "an element that reports outputs",
+        "output": "one of its outputs (`odyn elements TYPE`)",
+    },
+    "outputs.state": {
+        "name": "the column's name", "state": "a force with a state of its own",
+        "field": "one of its state's fields",
+    },
+    "outputs.global": {
+        "name": "the column's name", "quantity": ", ".join(GLOBAL_QUANTITIES),
+    },
+    "figures": {
+        "file": "a file name in the folder given to --figures, ending in "
+                + ", ".join(FIGURE_FORMATS),
+        "y": "an output column's name, or a list of them", "title": "the figure's title",
+        "ylabel": "the y axis' label", "offset": "added to the values drawn",
+        "scale": "multiplies the values drawn (after the offset)",
+    },
+}
+#: The keys each form of output column needs (the form is told by the first key it has of
+#: body, reaction, point, element, state; else a global quantity).
+REQUIRED_KEYS: Dict[str, Tuple[str, ...]] = {
+    "scene": ("bodies",),
+    "outputs.body": ("name", "body", "quantity"),
+    "outputs.reaction": ("name", "reaction", "quantity"),
+    "outputs.point": ("name", "point", "quantity"),
+    "outputs.element": ("name", "element", "output"),
+    "outputs.state": ("name", "state", "field"),
+    "outputs.global": ("name", "quantity"),
+    "figures": ("file", "y"),
+}
+TOP_KEYS = tuple(KEYS["scene"])
 
 
 class Scene:
@@ -318,21 +432,24 @@ def _check_component(d: Dict[str, Any], where: str, quantity: str, planar: bool)
     check_choice(d["component"], f"{where}.component", list(comps))
 
 
+def _check_form(o: Mapping[str, Any], where: str, form: str) -> Dict[str, Any]:
+    place = f"outputs.{form}"
+    return check_keys(o, where, tuple(KEYS[place]), REQUIRED_KEYS[place])
+
+
 def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
     if not isinstance(o, Mapping):
         fail(where, f"expected an output column (an object), got {o!r}")
     planar = model.space == "planar"
     if "body" in o:
-        d = check_keys(o, where, ("name", "body", "quantity", "component"),
-                       ("name", "body", "quantity"))
+        d = _check_form(o, where, "body")
         if d["body"] not in model.body_names[1:]:
             fail(f"{where}.body", f"no moving body named {d['body']!r}")
         check_choice(d["quantity"], f"{where}.quantity",
                      PLANAR_BODY_QUANTITIES if planar else BODY_QUANTITIES)
         _check_component(d, where, d["quantity"], planar)
     elif "reaction" in o:
-        d = check_keys(o, where, ("name", "reaction", "side", "axes", "quantity", "component"),
-                       ("name", "reaction", "quantity"))
+        d = _check_form(o, where, "reaction")
         d.setdefault("side", "b")
         d.setdefault("axes", "global")
         name = d["reaction"]
@@ -344,8 +461,7 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
         check_choice(d["quantity"], f"{where}.quantity", ("force", "torque"))
         _check_component(d, where, d["quantity"], planar)
     elif "point" in o:
-        d = check_keys(o, where, ("name", "point", "relative_to", "axes", "seen_from", "quantity",
-                                  "component"), ("name", "point", "quantity"))
+        d = _check_form(o, where, "point")
         points = model.point_names
         for key in ("point", "relative_to"):
             if key in d and d[key] not in points:
@@ -358,7 +474,7 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
         check_choice(d["quantity"], f"{where}.quantity", POINT_QUANTITIES)
         _check_component(d, where, d["quantity"], planar)
     elif "element" in o:
-        d = check_keys(o, where, ("name", "element", "output"), ("name", "element", "output"))
+        d = _check_form(o, where, "element")
         name = d["element"]
         if name not in model.element_names:
             fail(f"{where}.element", f"no element named {name!r}")
@@ -369,7 +485,7 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
             fail(f"{where}.element", f"'{name}' ({kind}) reports no outputs")
         check_choice(d["output"], f"{where}.output", outputs)
     elif "state" in o:
-        d = check_keys(o, where, ("name", "state", "field"), ("name", "state", "field"))
+        d = _check_form(o, where, "state")
         fields = {t: [f["name"] for f in e["state_fields"]]
                   for t, e in _schema.KNOWN[model.space].items()
                   if e["state_fields"] and t in model.element_types}
@@ -379,14 +495,14 @@ def _check_output(o: Any, where: str, model: BaseModel) -> Dict[str, Any]:
             fail(f"{where}.state", f"no stateful force ({kinds}) named {name!r}")
         check_choice(d["field"], f"{where}.field", fields[model.element_type(name)])
     else:
-        d = check_keys(o, where, ("name", "quantity"), ("name", "quantity"))
+        d = _check_form(o, where, "global")
         check_choice(d["quantity"], f"{where}.quantity", GLOBAL_QUANTITIES)
     check_name(d["name"], f"{where}.name")
     return d
 
 
 def _check_figure(f: Any, where: str, columns: List[str]) -> Dict[str, Any]:
-    d = check_keys(f, where, ("file", "y", "title", "ylabel", "offset", "scale"), ("file", "y"))
+    d = check_keys(f, where, tuple(KEYS["figures"]), REQUIRED_KEYS["figures"])
     check_name(d["file"], f"{where}.file")
     # A name inside the figures' folder: a scene from elsewhere writes nowhere else.
     if os.path.basename(d["file"]) != d["file"] or d["file"] in (".", ".."):
@@ -440,7 +556,7 @@ def from_dict(d: Any, where: str = "") -> Scene:
     if not isinstance(d, Mapping):
         fail(where or "scene", "expected a JSON object ({\"bodies\": [...], ...}) at the top, "
              f"got {_schema._describe(d)}")
-    d = check_keys(d, where, TOP_KEYS, ("bodies",))
+    d = check_keys(d, where, TOP_KEYS, REQUIRED_KEYS["scene"])
     prefix = f"{where}." if where else ""
     if "odyn" in d and d["odyn"] != FORMAT_VERSION:
         fail(f"{prefix}odyn", f"unsupported scene format version {d['odyn']!r}; expected "

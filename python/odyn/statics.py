@@ -51,7 +51,7 @@ def statics(model: BaseModel, *, coordinates: str = "absolute", tolerance: float
     Newton's method on the constraint manifold, with the exact stiffness (the forces' and the
     constraints' geometric stiffness); if it fails from the start pose, the load is applied in
     steps (`load_stepping`), and if that fails too, the iteration relaxes as a heavily damped
-    motion would (`relaxation`). Converged when |Phi| and the force imbalance (relative to the
+    motion would (`relaxation`). Converged when ``|Phi|`` and the force imbalance (relative to the
     loads) are below `tolerance`. `result.statics` says how: "method", "iterations",
     "load_steps", the residuals, and the equilibrium's stability: "stable", "neutral",
     "squared_frequencies" (1/s^2, negative along an unstable direction) and "least_stiff" (the
@@ -105,8 +105,8 @@ class Modes:
     Undamped (K_r x = omega^2 M_r x on the motions the joints allow): squared_frequencies
     (1/s^2), frequencies (Hz), shapes (n x k: each mode's motion in the velocity coordinates,
     whose names are `coordinates`, mass-normalized). Damped (the state matrix's eigenvalues s,
-    one of each conjugate pair): eigenvalues (complex, 1/s), natural_frequencies (|s|, Hz),
-    damped_frequencies (Im s, Hz), damping_ratios (-Re s / |s|). The linearization: basis
+    one of each conjugate pair): eigenvalues (complex, 1/s), natural_frequencies (``|s|``, Hz),
+    damped_frequencies (Im s, Hz), damping_ratios (``-Re s / |s|``). The linearization: basis
     (n x k, the minimal coordinates' motions), mass, damping, stiffness (k x k) and
     state_matrix (2k x 2k, for (z, z')); the sparse method leaves these empty, and the damped
     modes too where something damps. equilibrium: the pose they are about, a Result.
