@@ -474,7 +474,7 @@ class SpatialElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N).
@@ -504,7 +504,7 @@ class SpatialElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N).
@@ -535,7 +535,7 @@ class SpatialElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N), points.
@@ -568,7 +568,7 @@ class SpatialElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N), points.
@@ -1017,7 +1017,7 @@ class PlanarElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N).
@@ -1047,7 +1047,7 @@ class PlanarElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N).
@@ -1078,7 +1078,7 @@ class PlanarElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N), points.
@@ -1111,7 +1111,7 @@ class PlanarElements(_Adds):
         dissipation (s/m): d: the normal force is k delta^n (1 + d delta'); for a restitution e at
         an impact speed v, odyn.hunt_crossley_dissipation(e, v).
         friction: mu, the Coulomb friction coefficient.
-        slip_speed (m/s): v_s: the friction force is mu F_n tanh(|v_t| / v_s).
+        slip_speed (m/s): v_s: the friction force is mu F_n tanh(``|v_t|`` / v_s).
 
         Outputs (Result.output(name)): gap (m), gap_rate (m/s), normal_force (N), slip (m/s),
         friction_force (N), points.

@@ -108,6 +108,11 @@ def _wrap(text: str, indent: str, width: int = 99) -> List[str]:
     return lines
 
 
+def _literal_bars(text: str) -> str:
+    """`|v_t|` (a magnitude) as a literal in a docstring: reST reads bars as a substitution."""
+    return re.sub(r"\|([^|\s][^|]*?)\|", r"``|\1|``", text)
+
+
 def _method(element: Mapping[str, Any], space: str) -> List[str]:
     name = "add_" + element["type"]
     head = f"    def {name}({_signature(element['parameters'], space)}) -> str:"
@@ -125,12 +130,12 @@ def _method(element: Mapping[str, Any], space: str) -> List[str]:
                 line = "            "
             line = f"{line} {piece}" if line.strip() else line + piece
         lines.append(line)
-    lines.append('        """' + element["summary"].replace('"', "'"))
+    lines.append('        """' + _literal_bars(element["summary"].replace('"', "'")))
     lines[-1:] = _wrap(lines[-1].strip(), "        ")
     lines.append("")
     for p in element["parameters"]:
         unit = f" ({p['unit']})" if p["unit"] else ""
-        lines += _wrap(f"{p['name']}{unit}: {p['doc']}.", "        ")
+        lines += _wrap(f"{p['name']}{unit}: {_literal_bars(p['doc'])}.", "        ")
     if element["outputs"]:
         listed = ", ".join(f"{o['name']} ({o['unit']})" if o["unit"] else o["name"]
                            for o in element["outputs"])
