@@ -44,6 +44,8 @@ from .scene import Scene, load, loads, save
 from .kinematics import ModelReport, check, kinematics
 from .statics import Modes, modes, quasi_statics, statics
 from .linear import LinearModel, linearize
+from .settings import (Adams, AssemblySettings, Auto, Bdf, Dop853, Dopri5, GeneralizedAlpha, Hht,
+                       IntegratorSettings)
 
 #: Every element type that Model.add accepts (and scenes, except user_force and
 #: user_constraint).
@@ -55,12 +57,13 @@ planar_element_types = tuple(
 __version__ = "0.1.0"
 
 __all__ = [
-    "AssemblyError", "AssemblyWarning", "BaseModel", "BodyHistory", "Error", "Event",
-    "Interrupted", "LinearModel", "Model", "ModelError", "ModelReport", "Modes",
-    "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction", "RedundantConstraintsWarning",
-    "Result", "Scene", "SceneError", "SolverError", "Statistics", "ToleranceWarning", "assemble",
-    "check", "cmake_dir", "constant_velocity", "element_types", "frame", "harmonic",
-    "hunt_crossley_dissipation", "integrators", "kinematics", "linearize", "load", "loads",
-    "motion_function", "modes", "planar_element_types", "polynomial", "quasi_statics", "save",
-    "simulate", "statics",
+    "Adams", "AssemblyError", "AssemblySettings", "AssemblyWarning", "Auto", "BaseModel", "Bdf",
+    "BodyHistory", "Dop853", "Dopri5", "Error", "Event", "GeneralizedAlpha", "Hht",
+    "IntegratorSettings", "Interrupted", "LinearModel", "Model", "ModelError", "ModelReport",
+    "Modes", "PlanarBodyHistory", "PlanarModel", "PointHistory", "Reaction",
+    "RedundantConstraintsWarning", "Result", "Scene", "SceneError", "SolverError", "Statistics",
+    "ToleranceWarning", "assemble", "check", "cmake_dir", "constant_velocity", "element_types",
+    "frame", "harmonic", "hunt_crossley_dissipation", "integrators", "kinematics", "linearize",
+    "load", "loads", "modes", "motion_function", "planar_element_types", "polynomial",
+    "quasi_statics", "save", "simulate", "statics",
 ]

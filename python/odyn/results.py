@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
-from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tuple
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 
@@ -11,6 +12,8 @@ from . import _core
 from ._schema import (SceneError, check_callable, check_choice, check_count, check_number,
                       check_tolerance, fail)
 from .model import BaseModel, check_model
+from .settings import (AssemblySettings, IntegratorSettings, assembly_settings,
+                       integrator_settings, with_keywords)
 
 #: Integrators whose step is fixed unless `adaptive` (error control) is on.
 ADAPTIVE_OPTIONAL = ("generalized-alpha", "hht")
@@ -20,8 +23,9 @@ def chosen_integrator(settings: Mapping[str, Any]) -> str:
     """The integrator simulate() runs for these settings (a dict of its keyword arguments): the
     one named, else generalized-alpha when a step is given without rtol and atol, or when
     `adaptive` (generalized-alpha's option) is, else auto."""
-    if settings.get("integrator") is not None:
-        return settings["integrator"]
+    chosen = settings.get("integrator")
+    if chosen is not None:
+        return chosen if isinstance(chosen, str) else integrator_settings(chosen).NAME
     fixed_step = settings.get("step") is not None and settings.get("rtol") is None and \
         settings.get("atol") is None
     return "generalized-alpha" if fixed_step or settings.get("adaptive") is not None else "auto"
@@ -535,8 +539,10 @@ def assemble(model: BaseModel, tolerance: float = 1e-12, max_iterations: int = 5
 
 
 def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = None,
-             output_interval: float = 1e-3, integrator: Optional[str] = None,
-             rho_inf: float = 0.9, rtol: Optional[float] = None, atol: Optional[float] = None,
+             output_interval: float = 1e-3,
+             integrator: Union[str, IntegratorSettings, Mapping[str, Any], None] = None,
+             rho_inf: Optional[float] = None, rtol: Optional[float] = None,
+             atol: Optional[float] = None,
              max_step: Optional[float] = None, adaptive: Optional[bool] = None,
              progress: Optional[Callable[[float], None]] = None,
              newton_rtol: Optional[float] = None, newton_atol: Optional[float] = None,
@@ -544,7 +550,8 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
              max_iterations: Optional[int] = None,
              projection_tolerance: Optional[float] = None,
              order: Optional[int] = None, coordinates: str = "auto",
-             linear_solver: str = "auto") -> Result:
+             linear_solver: str = "auto",
+             assembly: Union[AssemblySettings, Mapping[str, Any], None] = None) -> Result:
     """Assembles, then integrates from t = 0 to t_end, landing on every output time.
 
     The assembly runs once per model: a later `simulate` (or one after `assemble`) of the
@@ -569,6 +576,15 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     tolerances per component of (q, v); max_step bounds an adaptive step.
     newton_rtol, newton_atol, constraint_tolerance and max_iterations tune the Newton
     iteration of generalized-alpha and hht.
+
+    Every setting of each integrator, those above and the rest (BDF's highest order, the reuse
+    of factorizations, the projection's iterations), is reachable through a typed settings
+    object: integrator=odyn.Dop853(rtol=1e-8, atol=1e-8), odyn.Bdf(max_order=3),
+    odyn.GeneralizedAlpha(step=1e-3, rho_inf=0.8), or a dict {"name": "dop853", "rtol": 1e-8}
+    (see odyn.settings); simulate's keywords given beside it override its fields, and one that
+    the integrator does not take is refused.
+    assembly: odyn.AssemblySettings(...) (or a dict of its fields): the assembly's tolerance,
+    iterations and the thresholds of its warning.
 
     coordinates: "auto" (the default) picks joint coordinates for a spatial model whose
     spanning tree leaves few closure equations (at most 30: the engine's 3), run by auto, dop853,
@@ -602,11 +618,26 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
     multipliers and a `RedundantConstraintsWarning` (see `Result.redundant_equations`).
     """
     check_model(model)
+    typed: Optional[IntegratorSettings] = None
+    if integrator is not None and not isinstance(integrator, str):
+        typed = integrator_settings(integrator)
+        keywords = {"step": step, "rtol": rtol, "atol": atol, "max_step": max_step,
+                    "rho_inf": rho_inf, "adaptive": adaptive, "newton_rtol": newton_rtol,
+                    "newton_atol": newton_atol, "constraint_tolerance": constraint_tolerance,
+                    "max_iterations": max_iterations,
+                    "projection_tolerance": projection_tolerance, "order": order}
+        typed = with_keywords(typed, keywords)  # a keyword beside it overrides its field
+        integrator = typed.NAME
+        step, rtol, atol, max_step = (typed.step, typed.rtol, typed.atol, typed.max_step)
+        rho_inf = getattr(typed, "rho_inf", None)
+        adaptive = getattr(typed, "adaptive", None)
     if integrator is None:
         integrator = chosen_integrator({"step": step, "rtol": rtol, "atol": atol,
                                         "adaptive": adaptive})
     if step is None:
         step = 1e-4
+    if rho_inf is None:
+        rho_inf = 0.9
     settings = _settings(step, t_end, output_interval, integrator, rho_inf, rtol, atol,
                          max_step, adaptive, newton_rtol=newton_rtol, newton_atol=newton_atol,
                          constraint_tolerance=constraint_tolerance,
@@ -616,6 +647,10 @@ def simulate(model: BaseModel, *, t_end: float = 1.0, step: Optional[float] = No
                          coordinates=check_choice(coordinates, "coordinates", COORDINATES),
                          linear_solver=check_choice(linear_solver, "linear_solver",
                                                     LINEAR_SOLVERS))
+    if typed is not None and typed.SECTION is not None:
+        settings[typed.SECTION] = typed.section()
+    if assembly is not None:
+        settings["assembly"] = dataclasses.asdict(assembly_settings(assembly))
     settings["events"] = model._event_table()
     if progress is not None:
         check_callable(progress, "progress")

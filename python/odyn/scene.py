@@ -68,6 +68,7 @@ from .kinematics import kinematics
 from .results import ADAPTIVE_OPTIONAL, COORDINATES, LINEAR_SOLVERS, Result, integrators, simulate
 from .linear import LinearModel, check_inputs, check_outputs, linearize
 from .statics import STATIC_COORDINATES, Modes, modes, quasi_statics, statics
+from .settings import INTEGRATOR_KEYWORDS, IntegratorSettings, integrator_settings
 
 FORMAT_VERSION = 1
 SPACES = ("spatial", "planar")
@@ -165,7 +166,9 @@ KEYS: Dict[str, Dict[str, str]] = {
         "output_interval": "time between output rows in s (default 1e-3; timed analyses)",
         "type": '"dynamic" (the default), "kinematic", "static", "quasi_static", "modes" or '
                 '"linear"',
-        "integrator": "a name of `odyn integrators`; left out, `simulate`'s choice",
+        "integrator": "a name of `odyn integrators`, or an object with the `name` and any of "
+                      "its settings (`{\"name\": \"bdf\", \"rtol\": 1e-6, \"max_order\": 3}`: "
+                      "[python.md](python.md#settings-objects)); left out, `simulate`'s choice",
         "rho_inf": "generalized-alpha's and HHT's spectral radius at infinity, in [0, 1]",
         "step": "the (first) step size in s",
         "rtol": "relative error tolerance, in (0, 1]",
@@ -330,7 +333,8 @@ class Scene:
                     fail(f"events: '{name}'", "a function event is a Python function and "
                          "cannot be saved in a scene file")
             out["events"] = [dict(e) for e in self.model._events.values()]
-        out["analysis"] = dict(self.analysis)
+        out["analysis"] = {k: v.to_dict() if isinstance(v, IntegratorSettings) else v
+                           for k, v in self.analysis.items()}
         out["outputs"] = [dict(o) for o in self.outputs]
         out["figures"] = [dict(f) for f in self.figures]
         return out
@@ -379,7 +383,13 @@ def _check_analysis(d: Any, where: str) -> Dict[str, Any]:
                  "leave it out")
     for key in ANALYSIS_OPTIONAL[1:]:
         if key in d:
-            if key == "integrator":
+            if key == "integrator" and isinstance(d[key], (Mapping, IntegratorSettings)):
+                out[key] = integrator_settings(d[key], f"{where}.{key}")
+                beside = [k for k in INTEGRATOR_KEYWORDS if k in d]
+                if beside:
+                    fail(f"{where}.{beside[0]}", "give the integrator's settings in its object "
+                         f"({where}.integrator), not beside it")
+            elif key == "integrator":
                 out[key] = check_choice(d[key], f"{where}.{key}", list(integrators()))
             elif key == "rho_inf":
                 out[key] = check_number(d[key], f"{where}.{key}", minimum=0.0)

@@ -122,7 +122,19 @@ BAD_MODELS = [
      KeyError, ["hindge", "constraints: hinge"]),
     ("contradictory joints", lambda: odyn.simulate(contradicted(), t_end=0.01),
      odyn.AssemblyError, ["could not be satisfied", "at joint 'second hinge'", "axes"]),
+    ("a spring with a free length between coincident points",
+     lambda: odyn.simulate(coincident_spring(), t_end=0.01),
+     odyn.ModelError, ["spring", "points coincide", "-10 N", "no direction"]),
 ]
+
+
+def coincident_spring():
+    """The pendulum with a spring of free length 0.1 m from the hinge's point to the bob's
+    point on it: once, it stored 1/2 k 0.1^2 while pushing with nothing."""
+    m = pendulum()
+    m.add_tsda(name="spring", body_a="ground", body_b="bob", point_b=[-1, 0, 0],
+               stiffness=100.0, free_length=0.1)
+    return m
 
 
 @pytest.mark.parametrize("kind, action, exception, words", BAD_MODELS,

@@ -198,3 +198,15 @@ def test_the_scene_reference_lists_every_key_the_loader_takes():
     for place, keys in scene.KEYS.items():
         assert all(doc.strip() for doc in keys.values()), place
         assert set(scene.REQUIRED_KEYS.get(place, ())) <= set(keys), place
+
+
+def test_the_catalogue_names_every_element_type():
+    """docs/index.md's catalogue (which the README's capability table summarizes) names every
+    element type the compiled core registers, in either space; a new type fails here until it
+    is added there."""
+    text = (ROOT / "docs" / "index.md").read_text()
+    catalogue = text[text.index("## The catalogue in detail"):text.index("## Layout")]
+    flat = re.sub(r"[`_\- ]", "", catalogue.lower())
+    missing = [t for t in sorted(set(odyn.element_types) | set(odyn.planar_element_types))
+               if t not in scene.PYTHON_ONLY and t.replace("_", "") not in flat]
+    assert not missing, f"docs/index.md's catalogue does not name {missing}"

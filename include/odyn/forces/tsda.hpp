@@ -70,6 +70,14 @@ class TsdaT {
   void evaluate(const Input& in, ForceBlocks<Space, 2>& out) const {
     const Geometry g = geometry(in);
     const double tension = tension_at(in.t, g);
+    // Between coincident points a tension has no direction to act along: it would be dropped
+    // while its spring still stores energy.
+    if (g.length == 0.0 && tension != 0.0)
+      throw ModelError(name_, "its points coincide at t = " + to_text(in.t) +
+                                  " s, where its tension of " + to_text(tension) +
+                                  " N has no direction; attach it at points apart (a free "
+                                  "length needs a length to push along), or use a bushing, "
+                                  "whose force has components");
     // Tension pulls b towards a and a towards b.
     out.force[0] = g.jacobian_a.transpose() * (tension * g.direction);
     out.force[1] = -g.jacobian_b.transpose() * (tension * g.direction);

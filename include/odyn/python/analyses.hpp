@@ -34,12 +34,58 @@ T get(const py::dict& d, const char* key, T fallback) {
   return d.contains(key) && !d[key].is_none() ? d[key].cast<T>() : fallback;
 }
 
+/// d[key], a dict of settings by their C++ names (the typed settings of odyn/settings.py come
+/// so), or an empty one.
+inline py::dict section(const py::dict& d, const char* key) {
+  return d.contains(key) && !d[key].is_none() ? d[key].cast<py::dict>() : py::dict();
+}
+
 inline AssemblySettings assembly_settings(const py::dict& d) {
   AssemblySettings s;
   s.tolerance = get(d, "assembly_tolerance", s.tolerance);
   s.max_iterations = get(d, "assembly_max_iterations", s.max_iterations);
   s.linear_solver = linear_solver_from_name(get(d, "linear_solver", std::string("auto")));
+  const py::dict a = section(d, "assembly");
+  s.tolerance = get(a, "tolerance", s.tolerance);
+  s.max_iterations = get(a, "max_iterations", s.max_iterations);
+  s.warn_translation = get(a, "warn_translation", s.warn_translation);
+  s.warn_rotation = get(a, "warn_rotation", s.warn_rotation);
   return s;
+}
+
+/// Every setting of each integrator, from its section of d (see section).
+inline void integrator_sections(const py::dict& d, DynamicsSettings& s) {
+  const py::dict g = section(d, "generalized_alpha");
+  auto& ga = s.generalized_alpha;
+  ga.rho_inf = get(g, "rho_inf", ga.rho_inf);
+  ga.newton_rtol = get(g, "newton_rtol", ga.newton_rtol);
+  ga.newton_atol = get(g, "newton_atol", ga.newton_atol);
+  ga.constraint_tolerance = get(g, "constraint_tolerance", ga.constraint_tolerance);
+  ga.max_iterations = get(g, "max_iterations", ga.max_iterations);
+  ga.reuse_iterations = get(g, "reuse_iterations", ga.reuse_iterations);
+  ga.adaptive = get(g, "adaptive", ga.adaptive);
+  ga.max_growth = get(g, "max_growth", ga.max_growth);
+  ga.consistent_outputs = get(g, "consistent_outputs", ga.consistent_outputs);
+  const py::dict e = section(d, "dormand_prince");
+  auto& dp = s.dormand_prince;
+  dp.projection_tolerance = get(e, "projection_tolerance", dp.projection_tolerance);
+  dp.max_projection_iterations = get(e, "max_projection_iterations", dp.max_projection_iterations);
+  dp.singular_threshold = get(e, "singular_threshold", dp.singular_threshold);
+  const py::dict b = section(d, "bdf");
+  s.bdf.max_order = get(b, "max_order", s.bdf.max_order);
+  s.bdf.local_error_fraction = get(b, "local_error_fraction", s.bdf.local_error_fraction);
+  s.bdf.newton_tolerance = get(b, "newton_tolerance", s.bdf.newton_tolerance);
+  s.bdf.constraint_tolerance = get(b, "constraint_tolerance", s.bdf.constraint_tolerance);
+  s.bdf.max_iterations = get(b, "max_iterations", s.bdf.max_iterations);
+  s.bdf.reuse_iterations = get(b, "reuse_iterations", s.bdf.reuse_iterations);
+  s.bdf.reuse_band = get(b, "reuse_band", s.bdf.reuse_band);
+  s.bdf.max_growth = get(b, "max_growth", s.bdf.max_growth);
+  const py::dict a = section(d, "adams");
+  s.adams.order = get(a, "order", s.adams.order);
+  s.adams.projection_tolerance = get(a, "projection_tolerance", s.adams.projection_tolerance);
+  s.adams.velocity_tolerance = get(a, "velocity_tolerance", s.adams.velocity_tolerance);
+  s.adams.max_projection_iterations =
+      get(a, "max_projection_iterations", s.adams.max_projection_iterations);
 }
 
 inline DynamicsSettings dynamics_settings(const py::dict& d) {
@@ -63,6 +109,7 @@ inline DynamicsSettings dynamics_settings(const py::dict& d) {
   auto& dp = s.dormand_prince;
   dp.projection_tolerance = get(d, "projection_tolerance", dp.projection_tolerance);
   s.adams.order = get(d, "order", s.adams.order);
+  integrator_sections(d, s);
   s.assembly = assembly_settings(d);
   return s;
 }
