@@ -26,15 +26,13 @@ from ._schema import (SceneError, _describe, check_count, check_flag, check_numb
 
 
 def _check(value: Any, where: str, kind: str) -> Any:
-    """A field's value checked by its kind (see the _KINDS of each class)."""
+    """A field's value checked by its kind (see each class's KINDS)."""
     if value is None:
         return None
     if kind == "relative":  # a relative tolerance, in (0, 1]
         return check_tolerance(value, where, relative=True)
     if kind == "positive":
         return check_number(value, where, positive=True)
-    if kind == "nonnegative":
-        return check_number(value, where, minimum=0.0)
     if kind == "fraction":  # in [0, 1]
         x = check_number(value, where, minimum=0.0)
         if x > 1.0:
@@ -292,18 +290,8 @@ def integrator_settings(value: Any, where: str = "integrator") -> IntegratorSett
     if name not in INTEGRATOR_SETTINGS:
         fail(f"{where}.name", f"unknown integrator {name!r}; known: "
              + ", ".join(INTEGRATOR_SETTINGS))
-    cls = INTEGRATOR_SETTINGS[name]
-    known = [f.name for f in fields(cls)]
-    for key in value:
-        if key != "name" and key not in known:
-            fail(f"{where}.{key}", f"{name} has no setting {key!r}; its settings: "
-                 + ", ".join(known))
-    try:
-        return cls(**{k: v for k, v in value.items() if k != "name"})
-    except SceneError as error:  # name the place in the scene, not the class
-        message = str(error).split(": ", 1)[-1]
-        field = str(error).split(":", 1)[0].split(".", 1)[-1]
-        raise SceneError(f"{where}.{field}: {message}") from None
+    return _built(INTEGRATOR_SETTINGS[name], {k: v for k, v in value.items() if k != "name"},
+                  where, name)
 
 
 def assembly_settings(value: Any, where: str = "assembly") -> AssemblySettings:
@@ -313,11 +301,21 @@ def assembly_settings(value: Any, where: str = "assembly") -> AssemblySettings:
     if not isinstance(value, Mapping):
         fail(where, f"expected odyn.AssemblySettings(...) or a dict of its fields, got "
              f"{_describe(value)}")
-    known = [f.name for f in fields(AssemblySettings)]
-    for key in value:
+    return _built(AssemblySettings, value, where, "the assembly")
+
+
+def _built(cls: Type[Any], params: Mapping[str, Any], where: str, owner: str) -> Any:
+    """cls(**params), its errors named by their place `where`.field (a scene's place)."""
+    known = [f.name for f in fields(cls)]
+    for key in params:
         if key not in known:
-            fail(f"{where}.{key}", f"no assembly setting {key!r}; they are " + ", ".join(known))
-    return AssemblySettings(**value)
+            fail(f"{where}.{key}", f"{owner} has no setting {key!r}; its settings: "
+                 + ", ".join(known))
+    try:
+        return cls(**params)
+    except SceneError as error:  # "Bdf.max_order: ..." -> "<where>.max_order: ..."
+        place, message = str(error).split(": ", 1)
+        raise SceneError(f"{where}.{place.split('.', 1)[-1]}: {message}") from None
 
 
 #: simulate()'s keywords that a settings object holds instead (see with_keywords).
