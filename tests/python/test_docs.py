@@ -210,3 +210,11 @@ def test_the_catalogue_names_every_element_type():
     missing = [t for t in sorted(set(odyn.element_types) | set(odyn.planar_element_types))
                if t not in scene.PYTHON_ONLY and t.replace("_", "") not in flat]
     assert not missing, f"docs/index.md's catalogue does not name {missing}"
+
+
+def test_the_readme_s_python_example_prints_what_the_readme_shows(capsys):
+    text = (ROOT / "README.md").read_text()
+    example = text.split("```python\n", 1)[1].split("```\n", 1)[0]
+    shown = text.split("It prints", 1)[1].split("```\n", 1)[1].split("```\n", 1)[0]
+    exec(compile(example, "README.md", "exec"), {"__name__": "__readme__"})
+    assert capsys.readouterr().out == shown
