@@ -426,11 +426,16 @@ TEST_CASE("A force that returns NaN during a run", "[errors]") {
       }));
   bob.model.add(sp::Gravity("gravity", {0.0, 0.0, -9.81}));
   Workspace ws(bob.model);
-  const odyn::DynamicsSettings settings = short_run();
+  odyn::DynamicsSettings settings = short_run();
+  odyn::RunSummary partial;  // what the run counted before it failed
+  settings.partial = &partial;
   double last_output = -1.0;
+  long outputs = 0;
   try {
-    odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings,
-                                                [&](const Workspace& w) { last_output = w.t; });
+    odyn::simulate_with<odyn::GeneralizedAlpha>(bob.model, ws, settings, [&](const Workspace& w) {
+      last_output = w.t;
+      ++outputs;
+    });
     FAIL("the run went on with a NaN force");
   } catch (const odyn::SolverError& e) {
     INFO(e.what());
@@ -441,6 +446,10 @@ TEST_CASE("A force that returns NaN during a run", "[errors]") {
                Catch::Contains("'kick'") && Catch::Contains("NaN") && Catch::Contains("t = 0.05"));
   }
   CHECK(last_output == Approx(0.05));
+  // Fixed steps of 1 ms, every one accepted up to t = 0.05; outputs at 0, 0.01, ..., 0.05.
+  CHECK(partial.statistics.steps == 50);
+  CHECK(partial.outputs == outputs);
+  CHECK(outputs == 6);
   // The workspace is back at the last good state, not filled with NaN.
   CHECK(ws.q.allFinite());
   CHECK(ws.v.allFinite());

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -30,6 +31,8 @@
 #include "odyn/integrators/integrator.hpp"
 
 namespace odyn {
+
+struct RunSummary;
 
 struct DynamicsSettings {
   /// s: the step of a fixed-step run (shortened so that steps land on output times), or the
@@ -61,6 +64,10 @@ struct DynamicsSettings {
   BdfSettings bdf = {};
   AdamsSettings adams = {};
   AssemblySettings assembly = {};
+  /// If set, a run that ends in an exception (a failed step, an error in an element, an
+  /// interrupt from the observer) first leaves there what it counted so far: the statistics,
+  /// outputs, residuals, events and wall time of its summary.
+  RunSummary* partial = nullptr;
 };
 
 /// Something a run did that its user should know although it succeeded.
@@ -612,6 +619,39 @@ void complete_workspace(Integrator& integrator) {
 }
 
 /// Adds the counters of a later part of a run.
+/// Hands a run's summary so far to DynamicsSettings::partial when the run ends in an exception
+/// (its destructor runs while the exception unwinds the run). `counted` completes the copy with
+/// what the live integrators counted.
+template <class Model, class Counted>
+class PartialOnThrow {
+ public:
+  PartialOnThrow(const DynamicsSettings& s, const RunSummary& summary,
+                 const Watcher<Model>& watcher, std::chrono::steady_clock::time_point started,
+                 Counted counted)
+      : s_(s), summary_(summary), watcher_(watcher), started_(started), counted_(counted) {}
+  PartialOnThrow(const PartialOnThrow&) = delete;
+  PartialOnThrow& operator=(const PartialOnThrow&) = delete;
+  ~PartialOnThrow() {
+    if (s_.partial == nullptr || std::uncaught_exceptions() <= unwinding_) return;
+    try {
+      *s_.partial = summary_;
+      counted_(s_.partial->statistics);
+      s_.partial->events = watcher_.events();
+      s_.partial->wall_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    } catch (...) {  // out of memory while unwinding: the partial summary is lost, not the error
+    }
+  }
+
+ private:
+  const DynamicsSettings& s_;
+  const RunSummary& summary_;
+  const Watcher<Model>& watcher_;
+  std::chrono::steady_clock::time_point started_;
+  Counted counted_;
+  int unwinding_ = std::uncaught_exceptions();
+};
+
 inline void add_statistics(IntegratorStatistics& total, const IntegratorStatistics& part) {
   total.steps += part.steps;
   total.newton_iterations += part.newton_iterations;
@@ -644,8 +684,11 @@ RunSummary simulate_with_function(const Model& model, Workspace<Model>& ws,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   detail::OutputRecorder<Model, const ObserverFunction<Model>> recorder{model, ws, observe,
                                                                         summary};
-  recorder(integrator);
   detail::Watcher<Model> watcher(watches);
+  const detail::PartialOnThrow<Model, std::function<void(IntegratorStatistics&)>> partial(
+      s, summary, watcher, started,
+      [&](IntegratorStatistics& counted) { counted = integrator.statistics(); });
+  recorder(integrator);
   watcher.start(ws);
   OutputGrid grid = detail::output_grid(s, ws.t);
   detail::run_integrator(model, ws, integrator, s, grid, recorder, [] { return false; }, watcher);
@@ -699,8 +742,14 @@ RunSummary simulate_auto_function(const Model& model, Workspace<Model>& ws,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   detail::OutputRecorder<Model, const ObserverFunction<Model>> recorder{model, ws, observe,
                                                                         summary};
-  recorder(*explicit_method);
   detail::Watcher<Model> watcher(watches);
+  // What the live dop853 counted (bdf's and generalized-alpha's count in the summary once they
+  // end; an exception that ends the run inside them loses their part).
+  const detail::PartialOnThrow<Model, std::function<void(IntegratorStatistics&)>> partial(
+      s, summary, watcher, started, [&](IntegratorStatistics& counted) {
+        if (explicit_method) detail::add_statistics(counted, explicit_method->statistics());
+      });
+  recorder(*explicit_method);
   watcher.start(ws);
   OutputGrid grid = detail::output_grid(s, ws.t);
   summary.integrator = "dop853";

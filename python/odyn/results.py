@@ -138,9 +138,10 @@ class Result:
     multipliers(joint), output(element, name), state(element).
     events: the model's events in time order (Event: name, time, direction, terminal);
     event_times(name); ended_by: the terminal event that ended the run, or None.
-    statistics: steps, rejected steps, Newton iterations, ... (None when the run stopped
-    early); summary: the same as a dict, with the assembly report; statics: a static
-    equilibrium's summary (odyn.statics); kinematics: a kinematic analysis's (odyn.kinematics).
+    statistics: steps, rejected steps, Newton iterations, ... (for a run that stopped early,
+    what it counted until then); summary: the same as a dict, with the assembly report;
+    statics: a static equilibrium's summary (odyn.statics); kinematics: a kinematic
+    analysis's (odyn.kinematics).
     A run that stopped early (the rows so far, an exception's `result`) says why:
     `interrupted` is True after Ctrl-C, `error` holds the message of the error that stopped it
     ("SolverError: at t = ..."), and `complete` is False for both.

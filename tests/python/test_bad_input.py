@@ -190,6 +190,39 @@ def test_a_run_ends_at_t_end_between_two_outputs(integrator):
         np.testing.assert_allclose(r.q[:, 2], -0.5 * 9.81 * r.t ** 2, rtol=0, atol=1e-9)
 
 
+class Broke(Exception):
+    pass
+
+
+def breaks_at(when):
+    """A force that raises once past `when` seconds."""
+    def force(t, bob):
+        if t > when:
+            raise Broke(f"broke at t = {t}")
+        return (0.0, 0.0, 0.0)
+    return force
+
+
+@pytest.mark.parametrize("integrator", ["generalized-alpha", "dop853", "bdf", "auto"])
+def test_a_failed_run_keeps_what_it_counted(integrator):
+    """A run that stops on an error keeps its statistics (once None): as many outputs as rows,
+    and about the steps of a whole run to the time it broke."""
+    settings = {"integrator": integrator, "step": 1e-3, "output_interval": 0.01}
+    if integrator != "generalized-alpha":
+        settings.update(rtol=1e-8, atol=1e-8)
+    m = pendulum()
+    m.add_point_force(name="push", body="bob", force=breaks_at(0.3))
+    with pytest.raises(Broke) as error:
+        odyn.simulate(m, t_end=1.0, **settings)
+    partial = error.value.result
+    assert not partial.complete and partial.error.startswith("Broke")
+    assert partial.statistics is not None
+    assert partial.statistics.outputs == len(partial.t)
+    whole = odyn.simulate(pendulum(), t_end=0.3, **settings)
+    assert abs(partial.statistics.steps - whole.statistics.steps) <= 2, (
+        partial.statistics.steps, whole.statistics.steps)
+
+
 @pytest.mark.parametrize("analysis", [odyn.simulate, odyn.kinematics, odyn.statics,
                                       odyn.quasi_statics, odyn.modes, odyn.linearize,
                                       odyn.check, odyn.assemble])

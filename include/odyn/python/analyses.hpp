@@ -509,7 +509,9 @@ template <class Box>
 py::dict simulate(Box& box, const py::dict& settings, py::object progress,
                   double progress_interval) {
   using M = typename Box::ModelType;
-  const DynamicsSettings s = dynamics_settings(settings);
+  DynamicsSettings s = dynamics_settings(settings);
+  RunSummary partial;  // what a run that fails counted so far
+  s.partial = &partial;
   Running<Box> running(box);
   odyn::Workspace<M> ws(box.model);
   Recorder<M> recorder(box.model);
@@ -526,8 +528,9 @@ py::dict simulate(Box& box, const py::dict& settings, py::object progress,
       error = std::current_exception();
     }
   }
+  if (error) summary = partial;
   py::dict out = recorder.to_python();
-  out["summary"] = error ? py::object(py::none()) : py::object(run_summary(summary));
+  out["summary"] = run_summary(summary);
   out["events"] = event_list(summary.events);
   out["ended_by"] = summary.ended_by.empty() ? py::object(py::none()) : py::str(summary.ended_by);
   out["error"] = error ? python_exception(error) : py::object(py::none());
