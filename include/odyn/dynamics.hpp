@@ -618,7 +618,6 @@ void complete_workspace(Integrator& integrator) {
   if constexpr (requires { integrator.refresh_blocks(); }) integrator.refresh_blocks();
 }
 
-/// Adds the counters of a later part of a run.
 /// Hands a run's summary so far to DynamicsSettings::partial when the run ends in an exception
 /// (its destructor runs while the exception unwinds the run). `counted` completes the copy with
 /// what the live integrators counted.
@@ -652,6 +651,7 @@ class PartialOnThrow {
   int unwinding_ = std::uncaught_exceptions();
 };
 
+/// Adds the counters of a later part of a run.
 inline void add_statistics(IntegratorStatistics& total, const IntegratorStatistics& part) {
   total.steps += part.steps;
   total.newton_iterations += part.newton_iterations;
