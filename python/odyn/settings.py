@@ -83,12 +83,6 @@ class IntegratorSettings:
         common = {f.name for f in fields(IntegratorSettings)}
         return tuple(f.name for f in fields(cls) if f.name not in common)
 
-    def run_settings(self) -> Dict[str, Any]:
-        """The settings simulate() takes as keywords (those given)."""
-        common = {f.name for f in fields(IntegratorSettings)}
-        return {k: v for k, v in dataclasses.asdict(self).items()
-                if k in common and v is not None}
-
     def section(self) -> Dict[str, Any]:
         """The integrator's own settings that were given, by their C++ names."""
         return {k: getattr(self, k) for k in self.own_fields() if getattr(self, k) is not None}
